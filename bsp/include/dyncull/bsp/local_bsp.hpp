@@ -1,0 +1,72 @@
+// Local axis-aligned BSP of one mesh, built once in object space and shared by every
+// instance of the mesh (the instance transform is applied at traversal time).
+// Paper: Two-level BSP for dynamic occlusion culling, section 3.1 (object partitioning);
+// split cost option from Scene subdivision for occlusion culling, section 3.2 (p-HBVO SAH).
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "dyncull/objects/aabb.hpp"
+#include "dyncull/objects/error.hpp"
+#include "dyncull/objects/mesh.hpp"
+
+namespace dyncull {
+
+inline constexpr std::uint32_t kInvalidIndex = std::numeric_limits<std::uint32_t>::max();
+
+enum class SplitMethod : std::uint8_t {
+    SpatialMedian,  ///< middle of the longest axis of the node box (the two-level paper)
+    Sah,            ///< surface-area heuristic over triangle barycentres (p-HBVO cost)
+};
+
+struct LocalBspParams {
+    std::uint32_t maxLeafTriangles = 4000;  ///< stop splitting at or below this many triangles
+    std::uint32_t maxDepth = 16;            ///< root has depth 0
+    SplitMethod method = SplitMethod::SpatialMedian;
+    /// Search window, as a fraction of the node extent along the split axis, in which the
+    /// plane may be nudged to cut fewer triangles (0 disables nudging).
+    float nudgeFraction = 0.1f;
+};
+
+/// One node. Nodes are stored depth-first (a node's subtree is the contiguous index range
+/// [self, self + subtreeSize)), and so are leaf triangles: the triangles of any node's
+/// subtree form one contiguous range [firstIndex, firstIndex + indexCount) of
+/// LocalBsp::mesh.indices, so a leaf — or a whole visible subtree — is one draw call.
+struct LocalBspNode {
+    Aabb box;  ///< tight object-space box of the node's (clipped) triangles
+    std::uint32_t children[2] = {kInvalidIndex, kInvalidIndex};  ///< [below, above] the plane; invalid for leaves
+    std::uint32_t firstIndex = 0;  ///< into LocalBsp::mesh.indices
+    std::uint32_t indexCount = 0;  ///< 3 x triangles of the whole subtree
+    std::uint32_t subtreeSize = 1;  ///< nodes in this subtree including itself
+    float split = 0.0f;  ///< plane position along `axis` (inner nodes)
+    std::uint8_t axis = 0;  ///< 0 = x, 1 = y, 2 = z (inner nodes)
+    std::uint8_t depth = 0;
+
+    bool isLeaf() const { return children[0] == kInvalidIndex; }
+};
+
+struct LocalBspStats {
+    std::size_t trianglesBefore = 0;
+    std::size_t trianglesAfter = 0;  ///< after clipping and re-triangulation
+    std::uint32_t leaves = 0;
+    std::uint32_t depth = 0;  ///< deepest leaf depth
+    double buildMs = 0.0;
+};
+
+/// The split mesh and its tree. Owns both. A mesh at or below maxLeafTriangles gets a
+/// single leaf root (no tree), so traversal code never special-cases it.
+struct LocalBsp {
+    Mesh mesh;  ///< the input re-triangulated along split planes, indices ordered by leaf
+    std::vector<LocalBspNode> nodes;  ///< nodes[0] is the root
+    LocalBspStats stats;
+
+    const LocalBspNode& root() const { return nodes[0]; }
+    bool hasTree() const { return nodes.size() > 1; }
+};
+
+/// Builds the BSP. Errors (never asserts) for invalid meshes or parameters.
+Expected<LocalBsp> buildLocalBsp(const Mesh& mesh, const LocalBspParams& params = {});
+
+}  // namespace dyncull

@@ -1,0 +1,75 @@
+// The objects of a dynamic scene: models (a split mesh and its local BSP, shared) and
+// instances of them with transforms. Hot per-object data is structure-of-arrays;
+// callers name objects by ObjectHandle (index + generation), never by pointer.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "dyncull/bsp/local_bsp.hpp"
+#include "dyncull/objects/aabb.hpp"
+#include "dyncull/objects/error.hpp"
+#include "dyncull/objects/transform.hpp"
+
+namespace dyncull {
+
+struct ObjectHandle {
+    std::uint32_t index = kInvalidIndex;
+    std::uint32_t generation = 0;
+    bool valid() const { return index != kInvalidIndex; }
+    friend bool operator==(const ObjectHandle&, const ObjectHandle&) = default;
+};
+
+using ModelId = std::uint32_t;
+
+/// Owns models and objects. Slots of removed objects go on a free list and their
+/// generation is bumped so stale handles are detected.
+class SceneObjects {
+public:
+    /// Takes ownership of a built local BSP; returns its id for addObject.
+    ModelId addModel(LocalBsp bsp);
+    const LocalBsp& model(ModelId id) const { return *models_[id]; }
+    std::size_t modelCount() const { return models_.size(); }
+
+    /// Adds an instance. Errors on an unknown model or an invalid transform.
+    Expected<ObjectHandle> addObject(ModelId model, const Transform& transform, bool isStatic = false);
+    Status removeObject(ObjectHandle h);
+    /// Sets a new world transform; marks the object moved for this frame's relink.
+    Status setTransform(ObjectHandle h, const Transform& transform);
+    bool alive(ObjectHandle h) const;
+
+    // --- SoA access by slot index (0 .. slotCount()-1); dead slots have alive(i) == false.
+    std::uint32_t slotCount() const { return static_cast<std::uint32_t>(model_.size()); }
+    std::uint32_t objectCount() const { return live_; }
+    bool alive(std::uint32_t i) const { return alive_[i] != 0; }
+    ModelId modelOf(std::uint32_t i) const { return model_[i]; }
+    const glm::mat4& matrix(std::uint32_t i) const { return matrix_[i]; }  ///< object -> world
+    const Transform& transform(std::uint32_t i) const { return transform_[i]; }
+    const Aabb& worldBox(std::uint32_t i) const { return worldBox_[i]; }  ///< world space
+    bool isStatic(std::uint32_t i) const { return static_[i] != 0; }
+    ObjectHandle handle(std::uint32_t i) const { return {i, generation_[i]}; }
+
+    /// Slots whose transform changed since the last clearMoved() (unique, ascending not guaranteed).
+    const std::vector<std::uint32_t>& moved() const { return moved_; }
+    void clearMoved();
+    /// Slots added or removed since the last clearStructural(); the loose BSP consumes these.
+    const std::vector<std::uint32_t>& added() const { return added_; }
+    const std::vector<std::uint32_t>& removed() const { return removed_; }
+    void clearStructural() { added_.clear(); removed_.clear(); }
+
+private:
+    std::vector<std::unique_ptr<LocalBsp>> models_;  // stable addresses: renderer caches per model
+    std::vector<ModelId> model_;
+    std::vector<glm::mat4> matrix_;
+    std::vector<Transform> transform_;
+    std::vector<Aabb> worldBox_;
+    std::vector<std::uint32_t> generation_;
+    std::vector<std::uint8_t> alive_, static_, movedFlag_;
+    std::vector<std::uint32_t> freeSlots_, moved_, added_, removed_;
+    std::uint32_t live_ = 0;
+};
+
+}  // namespace dyncull

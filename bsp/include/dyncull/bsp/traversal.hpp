@@ -1,0 +1,74 @@
+// Front-to-back traversal of the two-level hierarchy (global loose BSP, then each object's
+// local BSP with its transform applied). The scheduler drives it; nothing here draws.
+// Paper: Two-level BSP for dynamic occlusion culling, section 3.3 (traversing the structures)
+// and Algorithm 4 (ProcessVisibleNode ordering).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "dyncull/bsp/loose_bsp.hpp"
+#include "dyncull/bsp/scene_objects.hpp"
+#include "dyncull/objects/camera.hpp"
+
+namespace dyncull {
+
+/// A node of either level: object == kInvalidIndex names loose-BSP node `node`;
+/// otherwise `node` is a local-BSP node of object slot `object`'s model.
+struct NodeRef {
+    std::uint32_t object = kInvalidIndex;
+    std::uint32_t node = kInvalidIndex;
+    bool isSceneNode() const { return object == kInvalidIndex; }
+    friend bool operator==(const NodeRef&, const NodeRef&) = default;
+};
+
+/// Read-only view over a scene's two levels. Cheap to construct each frame; does not own.
+class TwoLevelTree {
+public:
+    TwoLevelTree(const LooseBsp& scene, const SceneObjects& objects) : scene_(&scene), objects_(&objects) {}
+
+    NodeRef root() const { return {kInvalidIndex, scene_->root()}; }
+    /// World-space box of the node (local boxes transformed by the object's matrix).
+    Aabb worldBox(NodeRef ref) const;
+    /// True for a local-BSP leaf: drawable as one index range.
+    bool isDrawable(NodeRef ref) const;
+    /// Children to process once `ref` is known visible, front-to-back for eye position `eye`
+    /// (world space), appended to `out`: for a scene node its near child, its objects
+    /// (as their local roots) sorted by box-centre distance, then its far child; for a
+    /// local inner node its near then far child; nothing for a leaf. Empty children skipped.
+    void expand(NodeRef ref, const glm::vec3& eye, std::vector<NodeRef>& out) const;
+
+    const LooseBsp& scene() const { return *scene_; }
+    const SceneObjects& objects() const { return *objects_; }
+
+private:
+    const LooseBsp* scene_;
+    const SceneObjects* objects_;
+};
+
+/// Visitor-style iterator: yields nodes front-to-back; after each yielded node the caller
+/// says whether to descend into it. Used by vfc mode and tests; the occlusion scheduler
+/// uses TwoLevelTree::expand directly to interleave queries.
+class FrontToBackIterator {
+public:
+    FrontToBackIterator(const TwoLevelTree& tree, const glm::vec3& eye);
+    /// Next node, or false when done.
+    bool next(NodeRef& out);
+    /// Descend into the node last returned by next() (otherwise its subtree is skipped).
+    void descend();
+
+private:
+    const TwoLevelTree* tree_;
+    glm::vec3 eye_;
+    std::vector<NodeRef> stack_;
+    std::vector<NodeRef> scratch_;
+    NodeRef current_;
+};
+
+/// Brute-force reference: every local leaf of every live object whose world box is not
+/// outside the frustum, by a linear scan of objects (no hierarchy). The tests' oracle.
+std::vector<NodeRef> frustumLeavesBruteForce(const SceneObjects& objects, const Frustum& frustum);
+
+}  // namespace dyncull

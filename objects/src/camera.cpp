@@ -1,0 +1,77 @@
+#include "dyncull/objects/camera.hpp"
+
+#include <cmath>
+#include <numbers>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+namespace dyncull {
+
+glm::mat4 Camera::view() const { return glm::lookAt(position, target, up); }
+
+glm::mat4 Camera::projection() const { return glm::perspective(fovYRadians, aspect, nearPlane, farPlane); }
+
+glm::vec3 Camera::forward() const { return glm::normalize(target - position); }
+
+Camera Camera::framing(const Aabb& box, float aspectRatio, const glm::vec3& dir) {
+    Camera c;
+    c.aspect = aspectRatio;
+    const glm::vec3 centre = box.empty() ? glm::vec3(0.0f) : box.center();
+    const float radius = box.empty() ? 1.0f : std::max(0.5f * glm::length(box.extent()), 1e-6f);
+    // Distance at which a sphere of `radius` fits the narrower field of view.
+    const float fovX = 2.0f * std::atan(std::tan(c.fovYRadians * 0.5f) * aspectRatio);
+    const float halfFov = 0.5f * std::min(c.fovYRadians, fovX);
+    const float dist = radius / std::sin(halfFov) * 1.05f;
+    c.target = centre;
+    c.position = centre + glm::normalize(dir) * dist;
+    c.nearPlane = std::max(dist - radius * 1.5f, dist * 1e-3f);
+    c.farPlane = dist + radius * 1.5f;
+    return c;
+}
+
+Status validateCamera(const Camera& c) {
+    auto finite = [](const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+    if (!finite(c.position) || !finite(c.target) || !finite(c.up)) return Error{"camera: position, target or up is not finite"};
+    if (!std::isfinite(c.fovYRadians) || c.fovYRadians <= 0.0f || c.fovYRadians >= std::numbers::pi_v<float>)
+        return Error{"camera: vertical field of view must be in (0, pi) radians"};
+    if (!std::isfinite(c.aspect) || c.aspect <= 0.0f) return Error{"camera: aspect must be positive"};
+    if (!std::isfinite(c.nearPlane) || !std::isfinite(c.farPlane) || c.nearPlane <= 0.0f || c.farPlane <= c.nearPlane)
+        return Error{"camera: need 0 < near < far"};
+    const glm::vec3 f = c.target - c.position;
+    if (glm::length(f) == 0.0f) return Error{"camera: target equals position"};
+    if (glm::length(glm::cross(f, c.up)) <= 1e-6f * glm::length(f) * glm::length(c.up))
+        return Error{"camera: up is parallel to the view direction"};
+    return {};
+}
+
+Frustum Frustum::fromMatrix(const glm::mat4& m) {
+    // Gribb-Hartmann: planes are sums/differences of the rows of the clip matrix.
+    const glm::vec4 r0(m[0][0], m[1][0], m[2][0], m[3][0]);
+    const glm::vec4 r1(m[0][1], m[1][1], m[2][1], m[3][1]);
+    const glm::vec4 r2(m[0][2], m[1][2], m[2][2], m[3][2]);
+    const glm::vec4 r3(m[0][3], m[1][3], m[2][3], m[3][3]);
+    Frustum f;
+    f.planes = {r3 + r0, r3 - r0, r3 + r1, r3 - r1, r3 + r2, r3 - r2};
+    for (glm::vec4& p : f.planes) {
+        const float len = glm::length(glm::vec3(p));
+        if (len > 0.0f) p /= len;
+    }
+    return f;
+}
+
+Frustum::Side Frustum::classify(const Aabb& box) const {
+    bool inside = true;
+    for (const glm::vec4& p : planes) {
+        const glm::vec3 n(p);
+        // Positive vertex (furthest along n) and negative vertex.
+        const glm::vec3 pv(n.x >= 0 ? box.max.x : box.min.x, n.y >= 0 ? box.max.y : box.min.y,
+                           n.z >= 0 ? box.max.z : box.min.z);
+        const glm::vec3 nv(n.x >= 0 ? box.min.x : box.max.x, n.y >= 0 ? box.min.y : box.max.y,
+                           n.z >= 0 ? box.min.z : box.max.z);
+        if (glm::dot(n, pv) + p.w < 0.0f) return Side::Outside;
+        if (glm::dot(n, nv) + p.w < 0.0f) inside = false;
+    }
+    return inside ? Side::Inside : Side::Intersecting;
+}
+
+}  // namespace dyncull
