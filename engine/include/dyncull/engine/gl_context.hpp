@@ -1,0 +1,88 @@
+// An OpenGL 4.5 core context to render into: headless EGL (default, renders into an
+// offscreen FBO) or a GLFW window (renders into the window's back buffer). The renderer
+// only sees framebuffer() and size(), so one code path serves both.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include <glm/glm.hpp>
+
+#include "dyncull/objects/error.hpp"
+
+namespace dyncull {
+
+enum class ContextKind : std::uint8_t {
+    HeadlessEgl,  ///< EGL without a surface (Mesa surfaceless / device platform), offscreen FBO
+    GlfwWindow,   ///< GLFW window on an X display (or Xvfb)
+};
+
+struct ContextOptions {
+    ContextKind kind = ContextKind::HeadlessEgl;
+    int width = 1280;   ///< pixels, >= 1: FBO size (headless) or window size
+    int height = 720;   ///< pixels, >= 1
+    int glMajor = 4;    ///< requested core-profile version; 4.5 is what the engine needs
+    int glMinor = 5;
+    bool debug = false;  ///< debug context + KHR_debug callback that counts GL errors
+    bool visible = true;  ///< windows only: show the window
+    std::string title = "dyncull";  ///< windows only
+};
+
+/// Owns the native context (and, headless, its FBO). Not copyable. The context is made
+/// current on creation; GL calls must happen on the creating thread.
+class GlContext {
+public:
+    /// Creates and makes current. Never throws or aborts: failures come back as an Error
+    /// naming every attempt, e.g. "EGL: surfaceless Mesa platform: eglInitialize failed
+    /// (EGL_NOT_INITIALIZED); device platform: no devices; ...".
+    static Expected<std::unique_ptr<GlContext>> create(const ContextOptions& options);
+
+    virtual ~GlContext() = default;
+    GlContext(const GlContext&) = delete;
+    GlContext& operator=(const GlContext&) = delete;
+
+    virtual void makeCurrent() = 0;
+    /// Windows: swap buffers and poll events. Headless: glFlush.
+    virtual void present() = 0;
+    /// Windows: the user asked to close. Headless: always false.
+    virtual bool shouldClose() const { return false; }
+
+    ContextKind kind() const { return kind_; }
+    /// GL name of the framebuffer to render into (0 = the window's default framebuffer).
+    std::uint32_t framebuffer() const { return framebuffer_; }
+    /// Framebuffer size in pixels (may differ from the window size on HiDPI screens).
+    glm::ivec2 size() const { return size_; }
+    /// GL_RENDERER / GL_VERSION strings of the context, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)".
+    const std::string& rendererName() const { return renderer_; }
+    const std::string& versionString() const { return version_; }
+    /// What created the context, e.g. "EGL surfaceless Mesa" or "GLFW 3.3.8 X11".
+    const std::string& platformName() const { return platform_; }
+
+    /// Drains glGetError and adds the count to glErrorCount(); in debug contexts the
+    /// KHR_debug callback also counts GL_DEBUG_TYPE_ERROR messages. Soak tests assert 0.
+    std::uint64_t checkErrors();
+    std::uint64_t glErrorCount() const { return errorCount_; }
+    bool isDebug() const { return debug_; }
+
+protected:
+    friend Expected<std::unique_ptr<GlContext>> createEglContext(const ContextOptions&);
+    friend Expected<std::unique_ptr<GlContext>> createGlfwContext(const ContextOptions&);
+    explicit GlContext(ContextKind kind) : kind_(kind) {}
+    /// Called by subclasses once current: queries strings, installs the debug callback.
+    void initCommon(bool debug);
+
+    ContextKind kind_;
+    std::uint32_t framebuffer_ = 0;
+    glm::ivec2 size_{0};
+    std::string renderer_, version_, platform_;
+    std::uint64_t errorCount_ = 0;
+    bool debug_ = false;
+};
+
+/// Headless EGL context with an RGBA8 + depth32F FBO of the requested size.
+Expected<std::unique_ptr<GlContext>> createEglContext(const ContextOptions& options);
+/// GLFW window context; fails cleanly when there is no display.
+Expected<std::unique_ptr<GlContext>> createGlfwContext(const ContextOptions& options);
+
+}  // namespace dyncull

@@ -1,0 +1,71 @@
+// Hardware occlusion queries for the scheduler: each query volume (8 world-space box
+// corners) is drawn with colour and depth writes off inside a GL query.
+// Conservative by default (GL_ANY_SAMPLES_PASSED_CONSERVATIVE); with a visible-pixel
+// threshold N > 0 it uses GL_SAMPLES_PASSED and calls a node visible only if more than
+// N samples passed (an approximate setting: it may drop up to N pixels per node).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "dyncull/objects/error.hpp"
+#include "dyncull/scheduler/query_backend.hpp"
+
+namespace dyncull {
+
+class GlContext;
+
+struct GlQueryParams {
+    std::uint32_t visiblePixelThreshold = 0;  ///< 0 = conservative (any sample passes)
+};
+
+/// Owns GL query objects, a streaming vertex buffer for volumes and a depth-only program.
+/// Needs the GL context current for its whole life. Queries are issued against whatever
+/// framebuffer is bound (the renderer's) with its depth buffer.
+class GlQueryBackend final : public QueryBackend {
+public:
+    static Expected<std::unique_ptr<GlQueryBackend>> create(GlContext& context, GlQueryParams params = {});
+    ~GlQueryBackend() override;
+
+    void beginFrame(const Camera& camera, int width, int height) override;
+    void beginBatch() override;
+    QueryId issue(const QueryVolume& volume) override;
+    void endBatch() override;
+    QueryResult poll(QueryId id) override;
+    QueryResult wait(QueryId id, double timeoutMs) override;
+    void release(QueryId id) override;
+    std::uint64_t samples(QueryId id) const override;
+
+    const GlQueryParams& params() const { return params_; }
+    void setParams(const GlQueryParams& p) { params_ = p; }
+    std::size_t poolSize() const { return queries_.size(); }
+    std::size_t inUse() const { return queries_.size() - free_.size(); }
+
+private:
+    GlQueryBackend(GlContext& context, GlQueryParams params) : context_(context), params_(params) {}
+    QueryResult fetch(QueryId id);
+
+    struct Slot {
+        std::uint32_t name = 0;  // GL query object
+        std::uint32_t target = 0;  // GL_ANY_SAMPLES_PASSED_CONSERVATIVE or GL_SAMPLES_PASSED
+        std::uint64_t samples = 0;
+        QueryResult result = QueryResult::NotReady;
+        bool live = false;
+    };
+    GlContext& context_;
+    GlQueryParams params_;
+    std::vector<Slot> queries_;
+    std::vector<QueryId> free_;
+    std::uint32_t program_ = 0, vao_ = 0, vbo_ = 0, ibo_ = 0;
+    int locViewProj_ = -1;
+    std::uint32_t vboCapacity_ = 0;  // volumes
+    std::uint32_t vboUsed_ = 0;      // volumes written this frame
+    glm::mat4 viewProj_{1.0f};
+    // State saved by beginBatch, restored by endBatch.
+    int savedDepthFunc_ = 0;
+    bool savedCull_ = false, savedDepthTest_ = false;
+    bool inBatch_ = false;
+};
+
+}  // namespace dyncull

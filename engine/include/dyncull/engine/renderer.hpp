@@ -1,0 +1,98 @@
+// Forward renderer for dyncull scenes: each mesh uploaded once (instances share its
+// buffers), drawn per index range with a model matrix, so a local-BSP leaf is one
+// glDrawElements on a sub-range with the object's matrix. Simple lighting so shapes
+// read clearly in screenshots: Lambert key light + ambient + a view-dependent fill.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "dyncull/engine/box_drawer.hpp"
+#include "dyncull/engine/gl_context.hpp"
+#include "dyncull/engine/image.hpp"
+#include "dyncull/objects/camera.hpp"
+#include "dyncull/objects/error.hpp"
+#include "dyncull/objects/mesh.hpp"
+
+namespace dyncull {
+
+/// Index of an uploaded mesh in the Renderer (0, 1, 2, ... in upload order).
+using MeshId = std::uint32_t;
+
+/// Counters of the current (or last) frame; reset by beginFrame.
+struct FrameStats {
+    std::uint64_t drawCalls = 0;
+    std::uint64_t triangles = 0;
+    std::uint64_t boxes = 0;  ///< drawBoxDepthTestOnly calls
+};
+
+/// Owns GL buffers/programs; the GlContext it was created with must outlive it and be
+/// current whenever a method is called.
+class Renderer {
+public:
+    /// Compiles the shaders. Error only if the driver rejects them.
+    static Expected<std::unique_ptr<Renderer>> create(GlContext& context);
+    ~Renderer();
+    Renderer(const Renderer&) = delete;
+    Renderer& operator=(const Renderer&) = delete;
+
+    /// Uploads positions + normals (interleaved) and indices once. Normals are computed
+    /// if the mesh has none. The mesh must pass validateMesh (loaders guarantee it) and
+    /// have fewer than 2^32 indices.
+    MeshId upload(const Mesh& mesh);
+    std::uint32_t indexCount(MeshId id) const { return meshes_[id].indexCount; }
+    std::size_t meshCount() const { return meshes_.size(); }
+    /// GPU memory held by mesh buffers, bytes.
+    std::size_t uploadedBytes() const { return uploadedBytes_; }
+
+    /// Binds the context framebuffer, sets the viewport to its full size, clears colour
+    /// and depth, and takes view/projection from `camera` (world space). The camera's
+    /// aspect is used as given (set it to width/height of the context).
+    void beginFrame(const Camera& camera);
+    /// Draws indices [firstIndex, firstIndex + indexCount) of mesh `id` with object-to-world
+    /// matrix `model`, in linear-ish RGB `colour` (0..1).
+    void drawRange(MeshId id, std::uint32_t firstIndex, std::uint32_t indexCount, const glm::mat4& model,
+                   const glm::vec3& colour);
+    void drawMesh(MeshId id, const glm::mat4& model, const glm::vec3& colour) {
+        drawRange(id, 0, indexCount(id), model, colour);
+    }
+    /// Occlusion-query proxy: rasterises `box` (world space, or the space `model` maps to
+    /// world) against depth with colour and depth writes off.
+    void drawBoxDepthTestOnly(const Aabb& box, const glm::mat4& model = glm::mat4(1.0f));
+    /// Flushes and counts GL errors into the context.
+    void endFrame();
+
+    /// Reads the context framebuffer as a top-down RGBA8 image (waits for the GPU).
+    Image readPixels() const;
+
+    const FrameStats& stats() const { return stats_; }
+    const glm::mat4& viewProjection() const { return viewProj_; }
+    GlContext& context() { return context_; }
+
+    /// Clear colour (dark grey-blue).
+    static constexpr glm::vec3 kClearColour{0.11f, 0.12f, 0.15f};
+
+private:
+    explicit Renderer(GlContext& context) : context_(context) {}
+
+    struct GpuMesh {
+        std::uint32_t vao = 0, vbo = 0, ibo = 0;
+        std::uint32_t indexCount = 0;
+    };
+    GlContext& context_;
+    std::vector<GpuMesh> meshes_;
+    std::size_t uploadedBytes_ = 0;
+    std::uint32_t program_ = 0;
+    int locViewProj_ = -1, locModel_ = -1, locNormalMat_ = -1, locColour_ = -1, locEye_ = -1, locLight_ = -1;
+    glm::mat4 viewProj_{1.0f};
+    FrameStats stats_;
+    std::unique_ptr<BoxDrawer> boxes_;
+};
+
+/// A pleasant, well-separated colour for object `id` (stable hash, fixed saturation/value).
+glm::vec3 colourForId(std::uint32_t id);
+
+}  // namespace dyncull

@@ -1,0 +1,184 @@
+// GL occlusion-query backend. Paper: Two-level BSP for dynamic occlusion culling,
+// section 3.4 (queries on node boxes, several in flight at once).
+#include "dyncull/engine/gl_query_backend.hpp"
+
+#include <cassert>
+#include <chrono>
+#include <cstring>
+#include <string>
+#include <thread>
+
+#include <epoxy/gl.h>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "dyncull/engine/gl_context.hpp"
+#include "shader_program.hpp"
+
+namespace dyncull {
+namespace {
+
+const char* const kVolumeVs = R"(#version 450 core
+layout(location = 0) in vec3 aPos;
+uniform mat4 uViewProj;
+void main() { gl_Position = uViewProj * vec4(aPos, 1.0); }
+)";
+const char* const kVolumeFs = R"(#version 450 core
+void main() {}
+)";
+
+// 12 triangles of a box whose corner i has x from bit 0, y from bit 1, z from bit 2.
+// Winding does not matter: face culling is off so a volume seen from inside or from any
+// side still rasterises.
+const std::uint8_t kBoxIndices[36] = {
+    0, 2, 1, 1, 2, 3,  // z = min
+    4, 5, 6, 5, 7, 6,  // z = max
+    0, 1, 4, 1, 5, 4,  // y = min
+    2, 6, 3, 3, 6, 7,  // y = max
+    0, 4, 2, 2, 4, 6,  // x = min
+    1, 3, 5, 3, 7, 5,  // x = max
+};
+
+constexpr std::uint32_t kInitialVolumes = 4096;
+
+}  // namespace
+
+Expected<std::unique_ptr<GlQueryBackend>> GlQueryBackend::create(GlContext& context, GlQueryParams params) {
+    std::unique_ptr<GlQueryBackend> b(new GlQueryBackend(context, params));
+    std::string log;
+    b->program_ = detail::buildProgram(kVolumeVs, kVolumeFs, log);
+    if (!b->program_) return Error{"query volume shader: " + log};
+    b->locViewProj_ = glGetUniformLocation(b->program_, "uViewProj");
+    glCreateBuffers(1, &b->ibo_);
+    glNamedBufferStorage(b->ibo_, sizeof(kBoxIndices), kBoxIndices, 0);
+    glCreateBuffers(1, &b->vbo_);
+    b->vboCapacity_ = kInitialVolumes;
+    glNamedBufferData(b->vbo_, b->vboCapacity_ * 8 * sizeof(glm::vec3), nullptr, GL_STREAM_DRAW);
+    glCreateVertexArrays(1, &b->vao_);
+    glVertexArrayVertexBuffer(b->vao_, 0, b->vbo_, 0, sizeof(glm::vec3));
+    glVertexArrayElementBuffer(b->vao_, b->ibo_);
+    glEnableVertexArrayAttrib(b->vao_, 0);
+    glVertexArrayAttribFormat(b->vao_, 0, 3, GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribBinding(b->vao_, 0, 0);
+    return b;
+}
+
+GlQueryBackend::~GlQueryBackend() {
+    for (Slot& s : queries_) glDeleteQueries(1, &s.name);
+    glDeleteVertexArrays(1, &vao_);
+    glDeleteBuffers(1, &vbo_);
+    glDeleteBuffers(1, &ibo_);
+    if (program_) glDeleteProgram(program_);
+}
+
+void GlQueryBackend::beginFrame(const Camera& camera, int, int) {
+    viewProj_ = camera.viewProjection();
+    // Orphan last frame's volumes so writing this frame's never waits on the rasteriser.
+    glNamedBufferData(vbo_, vboCapacity_ * 8 * sizeof(glm::vec3), nullptr, GL_STREAM_DRAW);
+    vboUsed_ = 0;
+}
+
+void GlQueryBackend::beginBatch() {
+    assert(!inBatch_);
+    inBatch_ = true;
+    savedCull_ = glIsEnabled(GL_CULL_FACE);
+    savedDepthTest_ = glIsEnabled(GL_DEPTH_TEST);
+    glGetIntegerv(GL_DEPTH_FUNC, &savedDepthFunc_);
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    glDepthMask(GL_FALSE);
+    glEnable(GL_DEPTH_TEST);
+    // LEQUAL: a volume face coplanar with drawn geometry counts as visible (conservative).
+    glDepthFunc(GL_LEQUAL);
+    glDisable(GL_CULL_FACE);
+    glUseProgram(program_);
+    glUniformMatrix4fv(locViewProj_, 1, GL_FALSE, glm::value_ptr(viewProj_));
+    glBindVertexArray(vao_);
+}
+
+QueryId GlQueryBackend::issue(const QueryVolume& volume) {
+    assert(inBatch_);
+    if (vboUsed_ == vboCapacity_) {
+        // Grow: earlier draws of this frame keep the orphaned storage they referenced.
+        vboCapacity_ *= 2;
+        glNamedBufferData(vbo_, vboCapacity_ * 8 * sizeof(glm::vec3), nullptr, GL_STREAM_DRAW);
+        vboUsed_ = 0;
+    }
+    glNamedBufferSubData(vbo_, vboUsed_ * 8 * sizeof(glm::vec3), 8 * sizeof(glm::vec3), volume.corners.data());
+
+    QueryId id;
+    if (!free_.empty()) {
+        id = free_.back();
+        free_.pop_back();
+    } else {
+        id = static_cast<QueryId>(queries_.size());
+        queries_.emplace_back();
+        glCreateQueries(GL_ANY_SAMPLES_PASSED_CONSERVATIVE, 1, &queries_[id].name);
+        queries_[id].target = GL_ANY_SAMPLES_PASSED_CONSERVATIVE;
+    }
+    Slot& s = queries_[id];
+    const std::uint32_t target = params_.visiblePixelThreshold > 0 ? GL_SAMPLES_PASSED : GL_ANY_SAMPLES_PASSED_CONSERVATIVE;
+    if (s.target != target) {
+        // A query object is bound to the target it was created for.
+        glDeleteQueries(1, &s.name);
+        glCreateQueries(target, 1, &s.name);
+        s.target = target;
+    }
+    s.live = true;
+    s.result = QueryResult::NotReady;
+    s.samples = 0;
+    glBeginQuery(target, s.name);
+    glDrawElementsBaseVertex(GL_TRIANGLES, 36, GL_UNSIGNED_BYTE, nullptr, static_cast<GLint>(vboUsed_ * 8));
+    glEndQuery(target);
+    ++vboUsed_;
+    return id;
+}
+
+void GlQueryBackend::endBatch() {
+    assert(inBatch_);
+    inBatch_ = false;
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glDepthMask(GL_TRUE);
+    glDepthFunc(static_cast<GLenum>(savedDepthFunc_));
+    if (savedCull_) glEnable(GL_CULL_FACE);
+    if (!savedDepthTest_) glDisable(GL_DEPTH_TEST);
+    // Submit now so the rasteriser works on the queries while the CPU traverses on.
+    glFlush();
+}
+
+QueryResult GlQueryBackend::fetch(QueryId id) {
+    Slot& s = queries_[id];
+    assert(s.live);
+    if (s.result != QueryResult::NotReady) return s.result;
+    GLuint available = 0;
+    glGetQueryObjectuiv(s.name, GL_QUERY_RESULT_AVAILABLE, &available);
+    if (!available) return QueryResult::NotReady;
+    GLuint64 value = 0;
+    glGetQueryObjectui64v(s.name, GL_QUERY_RESULT, &value);
+    s.samples = value;
+    const bool visible = s.target == GL_SAMPLES_PASSED ? value > params_.visiblePixelThreshold : value != 0;
+    s.result = visible ? QueryResult::Visible : QueryResult::Occluded;
+    return s.result;
+}
+
+QueryResult GlQueryBackend::poll(QueryId id) { return fetch(id); }
+
+QueryResult GlQueryBackend::wait(QueryId id, double timeoutMs) {
+    const auto t0 = std::chrono::steady_clock::now();
+    glFlush();
+    for (;;) {
+        const QueryResult r = fetch(id);
+        if (r != QueryResult::NotReady) return r;
+        const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        if (ms > timeoutMs) return QueryResult::NotReady;  // caller counts it visible
+        std::this_thread::yield();
+    }
+}
+
+void GlQueryBackend::release(QueryId id) {
+    assert(queries_[id].live);
+    queries_[id].live = false;
+    free_.push_back(id);
+}
+
+std::uint64_t GlQueryBackend::samples(QueryId id) const { return queries_[id].samples; }
+
+}  // namespace dyncull

@@ -1,0 +1,179 @@
+// Forward renderer: one VAO/VBO/IBO per mesh, drawn per index range with a model matrix.
+#include "dyncull/engine/renderer.hpp"
+
+#include <cassert>
+#include <cmath>
+
+#include <epoxy/gl.h>
+#include <glm/gtc/matrix_inverse.hpp>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "shader_program.hpp"
+
+namespace dyncull {
+
+Expected<std::unique_ptr<Renderer>> Renderer::create(GlContext& context) {
+    std::unique_ptr<Renderer> r(new Renderer(context));
+    std::string log;
+    r->program_ = detail::buildProgram(detail::kLitVertexShader, detail::kLitFragmentShader, log);
+    if (!r->program_) return Error{"renderer: lit shader rejected by " + context.rendererName() + ": " + log};
+    r->locViewProj_ = glGetUniformLocation(r->program_, "uViewProj");
+    r->locModel_ = glGetUniformLocation(r->program_, "uModel");
+    r->locNormalMat_ = glGetUniformLocation(r->program_, "uNormalMat");
+    r->locColour_ = glGetUniformLocation(r->program_, "uColour");
+    r->locEye_ = glGetUniformLocation(r->program_, "uEye");
+    r->locLight_ = glGetUniformLocation(r->program_, "uLightDir");
+    r->boxes_ = std::make_unique<BoxDrawer>();
+    if (!r->boxes_->valid()) return Error{std::string("renderer: box shader rejected: ") + r->boxes_->log()};
+    return r;
+}
+
+Renderer::~Renderer() {
+    for (GpuMesh& m : meshes_) {
+        glDeleteVertexArrays(1, &m.vao);
+        glDeleteBuffers(1, &m.vbo);
+        glDeleteBuffers(1, &m.ibo);
+    }
+    boxes_.reset();
+    if (program_) glDeleteProgram(program_);
+}
+
+MeshId Renderer::upload(const Mesh& mesh) {
+    assert(validateMesh(mesh).empty());
+    Mesh withNormals;
+    const Mesh* src = &mesh;
+    if (mesh.normals.size() != mesh.positions.size()) {
+        withNormals = mesh;
+        computeNormals(withNormals);
+        src = &withNormals;
+    }
+    // Interleaved position/normal: one fetch stream per vertex.
+    std::vector<glm::vec3> interleaved(src->positions.size() * 2);
+    for (std::size_t i = 0; i < src->positions.size(); ++i) {
+        interleaved[2 * i] = src->positions[i];
+        interleaved[2 * i + 1] = src->normals[i];
+    }
+    GpuMesh g;
+    g.indexCount = static_cast<std::uint32_t>(src->indices.size());
+    const GLsizeiptr vbytes = static_cast<GLsizeiptr>(interleaved.size() * sizeof(glm::vec3));
+    const GLsizeiptr ibytes = static_cast<GLsizeiptr>(src->indices.size() * sizeof(std::uint32_t));
+    glCreateBuffers(1, &g.vbo);
+    // Storage must be non-zero sized; an empty mesh still gets valid (1-byte) buffers.
+    glNamedBufferStorage(g.vbo, vbytes ? vbytes : 1, vbytes ? interleaved.data() : nullptr, 0);
+    glCreateBuffers(1, &g.ibo);
+    glNamedBufferStorage(g.ibo, ibytes ? ibytes : 1, ibytes ? src->indices.data() : nullptr, 0);
+    glCreateVertexArrays(1, &g.vao);
+    glVertexArrayVertexBuffer(g.vao, 0, g.vbo, 0, 2 * sizeof(glm::vec3));
+    glVertexArrayElementBuffer(g.vao, g.ibo);
+    glEnableVertexArrayAttrib(g.vao, 0);
+    glVertexArrayAttribFormat(g.vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribBinding(g.vao, 0, 0);
+    glEnableVertexArrayAttrib(g.vao, 1);
+    glVertexArrayAttribFormat(g.vao, 1, 3, GL_FLOAT, GL_FALSE, sizeof(glm::vec3));
+    glVertexArrayAttribBinding(g.vao, 1, 0);
+    uploadedBytes_ += static_cast<std::size_t>(vbytes + ibytes);
+    meshes_.push_back(g);
+    return static_cast<MeshId>(meshes_.size() - 1);
+}
+
+void Renderer::beginFrame(const Camera& camera) {
+    stats_ = {};
+    const glm::ivec2 size = context_.size();
+    glBindFramebuffer(GL_FRAMEBUFFER, context_.framebuffer());
+    glViewport(0, 0, size.x, size.y);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glDepthMask(GL_TRUE);
+    glClearColor(kClearColour.r, kClearColour.g, kClearColour.b, 1.0f);
+    glClearDepth(1.0);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_CULL_FACE);  // loaded meshes have unreliable winding; the shader lights both sides
+
+    viewProj_ = camera.viewProjection();
+    // Key light over the viewer's left shoulder, so silhouettes and creases get shading.
+    const glm::vec3 f = camera.forward();
+    glm::vec3 right = glm::cross(f, camera.up);
+    right = glm::length(right) > 0.0f ? glm::normalize(right) : glm::vec3(1, 0, 0);
+    const glm::vec3 up = glm::cross(right, f);
+    const glm::vec3 light = glm::normalize(-f + 0.9f * up - 0.6f * right);
+
+    glUseProgram(program_);
+    glUniformMatrix4fv(locViewProj_, 1, GL_FALSE, glm::value_ptr(viewProj_));
+    glUniform3fv(locEye_, 1, glm::value_ptr(camera.position));
+    glUniform3fv(locLight_, 1, glm::value_ptr(light));
+}
+
+void Renderer::drawRange(MeshId id, std::uint32_t firstIndex, std::uint32_t count, const glm::mat4& model,
+                         const glm::vec3& colour) {
+    assert(id < meshes_.size());
+    const GpuMesh& g = meshes_[id];
+    assert(firstIndex <= g.indexCount && count <= g.indexCount - firstIndex);
+    if (count == 0) return;
+    // Inverse-transpose keeps normals perpendicular under non-uniform scale; done once per
+    // draw on the CPU instead of per vertex.
+    const glm::mat3 normalMat = glm::inverseTranspose(glm::mat3(model));
+    glUseProgram(program_);
+    glUniformMatrix4fv(locModel_, 1, GL_FALSE, glm::value_ptr(model));
+    glUniformMatrix3fv(locNormalMat_, 1, GL_FALSE, glm::value_ptr(normalMat));
+    glUniform3fv(locColour_, 1, glm::value_ptr(colour));
+    glBindVertexArray(g.vao);
+    glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(count), GL_UNSIGNED_INT,
+                   reinterpret_cast<const void*>(static_cast<std::uintptr_t>(firstIndex) * sizeof(std::uint32_t)));
+    ++stats_.drawCalls;
+    stats_.triangles += count / 3;
+}
+
+void Renderer::drawBoxDepthTestOnly(const Aabb& box, const glm::mat4& model) {
+    boxes_->drawDepthTestOnly(box, model, viewProj_);
+    ++stats_.boxes;
+}
+
+void Renderer::endFrame() {
+    glFlush();
+    context_.checkErrors();
+}
+
+Image Renderer::readPixels() const {
+    Image img;
+    const glm::ivec2 size = context_.size();
+    img.width = size.x;
+    img.height = size.y;
+    const std::size_t rowBytes = static_cast<std::size_t>(size.x) * 4;
+    std::vector<std::uint8_t> bottomUp(rowBytes * static_cast<std::size_t>(size.y));
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, context_.framebuffer());
+    if (context_.framebuffer() == 0) glReadBuffer(GL_BACK);  // window: before the swap
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, size.x, size.y, GL_RGBA, GL_UNSIGNED_BYTE, bottomUp.data());
+    // GL rows start at the bottom; images are top-down.
+    img.rgba.resize(bottomUp.size());
+    for (int y = 0; y < size.y; ++y)
+        std::copy_n(bottomUp.data() + static_cast<std::size_t>(size.y - 1 - y) * rowBytes, rowBytes,
+                    img.rgba.data() + static_cast<std::size_t>(y) * rowBytes);
+    return img;
+}
+
+glm::vec3 colourForId(std::uint32_t id) {
+    // Golden-ratio hue steps keep neighbouring ids far apart on the colour wheel; the
+    // integer hash decorrelates ids that are multiples of each other.
+    std::uint32_t h = id * 0x9E3779B1u;
+    h ^= h >> 15;
+    h *= 0x85EBCA77u;
+    h ^= h >> 13;
+    const float hue = std::fmod(static_cast<float>(h & 0xFFFFu) / 65536.0f + 0.61803399f * static_cast<float>(id % 64u), 1.0f);
+    const float s = 0.45f, v = 0.9f;
+    const float hh = hue * 6.0f;
+    const int sector = static_cast<int>(hh) % 6;
+    const float fpart = hh - std::floor(hh);
+    const float p = v * (1 - s), q = v * (1 - s * fpart), t = v * (1 - s * (1 - fpart));
+    switch (sector) {
+        case 0: return {v, t, p};
+        case 1: return {q, v, p};
+        case 2: return {p, v, t};
+        case 3: return {p, q, v};
+        case 4: return {t, p, v};
+        default: return {v, p, q};
+    }
+}
+
+}  // namespace dyncull
