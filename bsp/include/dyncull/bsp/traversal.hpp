@@ -54,7 +54,7 @@ private:
 class FrontToBackIterator {
 public:
     FrontToBackIterator(const TwoLevelTree& tree, const glm::vec3& eye);
-    /// Next node, or false when done.
+    /// Next node, or false when done. Starts with the root (nothing at all for an empty scene).
     bool next(NodeRef& out);
     /// Descend into the node last returned by next() (otherwise its subtree is skipped).
     void descend();
@@ -67,8 +67,12 @@ private:
     NodeRef current_;
 };
 
-/// Brute-force reference: every local leaf of every live object whose world box is not
-/// outside the frustum, by a linear scan of objects (no hierarchy). The tests' oracle.
+/// Brute-force reference: every non-empty local leaf (indexCount > 0; a single-leaf root is
+/// always included) of every live object whose own world box (leaf box under the object's
+/// matrix) is not outside the frustum, by a linear scan of objects (no hierarchy), in slot
+/// then node order. Equals the drawable nodes FrontToBackIterator yields when the caller
+/// descends exactly into the nodes not outside the frustum (boxes nest, classify is monotone).
+/// The tests' oracle. Returns a new vector (owned by the caller).
 std::vector<NodeRef> frustumLeavesBruteForce(const SceneObjects& objects, const Frustum& frustum);
 
 }  // namespace dyncull

@@ -1,0 +1,109 @@
+// Object store of the two-level scheme: shared models (split mesh + local BSP) and their
+// instances, hot per-object data as structure-of-arrays, handles with generations.
+// Paper: Two-level BSP for dynamic occlusion culling, section 3.1 (a transformation
+// matrix per object, re-evaluated after every dynamic change).
+#include "dyncull/bsp/scene_objects.hpp"
+
+#include <string>
+
+namespace dyncull {
+
+namespace {
+
+std::string handleText(ObjectHandle h) {
+    return "handle (slot " + std::to_string(h.index) + ", generation " + std::to_string(h.generation) + ")";
+}
+
+}  // namespace
+
+ModelId SceneObjects::addModel(LocalBsp bsp) {
+    assert(!bsp.nodes.empty() && "a LocalBsp always has a root node");
+    models_.push_back(std::make_unique<LocalBsp>(std::move(bsp)));
+    return static_cast<ModelId>(models_.size() - 1);
+}
+
+// Validates the transform and computes matrix + world box; shared by add and setTransform
+// so both reject exactly the same inputs and never leave half-updated state.
+static Status placement(const LocalBsp& model, const Transform& t, glm::mat4& matrix, Aabb& box) {
+    if (Status s = validateTransform(t); !s) return s;
+    const Aabb& local = model.root().box;
+    if (local.empty() || !local.finite()) return Error{"model root box is empty or not finite"};
+    matrix = t.matrix();
+    box = transformAabb(matrix, local);
+    if (!box.finite()) return Error{"transform: world box overflows float range"};
+    return {};
+}
+
+Expected<ObjectHandle> SceneObjects::addObject(ModelId model, const Transform& transform, bool isStatic) {
+    if (model >= models_.size())
+        return Error{"addObject: unknown model id " + std::to_string(model) + " (" +
+                     std::to_string(models_.size()) + " models)"};
+    glm::mat4 m;
+    Aabb box;
+    if (Status s = placement(*models_[model], transform, m, box); !s)
+        return Error{"addObject: " + s.message()};
+
+    std::uint32_t i;
+    if (!freeSlots_.empty()) {
+        i = freeSlots_.back();
+        freeSlots_.pop_back();
+    } else {
+        i = slotCount();
+        model_.push_back(0);
+        matrix_.emplace_back(1.0f);
+        transform_.emplace_back();
+        worldBox_.emplace_back();
+        generation_.push_back(0);
+        alive_.push_back(0);
+        static_.push_back(0);
+        movedFlag_.push_back(0);
+    }
+    model_[i] = model;
+    matrix_[i] = m;
+    transform_[i] = transform;
+    worldBox_[i] = box;
+    alive_[i] = 1;
+    static_[i] = isStatic ? 1 : 0;
+    added_.push_back(i);
+    ++live_;
+    return ObjectHandle{i, generation_[i]};
+}
+
+bool SceneObjects::alive(ObjectHandle h) const {
+    return h.index < slotCount() && alive_[h.index] != 0 && generation_[h.index] == h.generation;
+}
+
+Status SceneObjects::removeObject(ObjectHandle h) {
+    if (!alive(h)) return Error{"removeObject: stale or invalid " + handleText(h)};
+    const std::uint32_t i = h.index;
+    alive_[i] = 0;
+    ++generation_[i];  // every handle to the old object is stale from now on
+    freeSlots_.push_back(i);
+    removed_.push_back(i);
+    --live_;
+    return {};
+}
+
+Status SceneObjects::setTransform(ObjectHandle h, const Transform& transform) {
+    if (!alive(h)) return Error{"setTransform: stale or invalid " + handleText(h)};
+    const std::uint32_t i = h.index;
+    glm::mat4 m;
+    Aabb box;
+    if (Status s = placement(*models_[model_[i]], transform, m, box); !s)
+        return Error{"setTransform: " + s.message()};
+    matrix_[i] = m;
+    transform_[i] = transform;
+    worldBox_[i] = box;
+    if (!movedFlag_[i]) {
+        movedFlag_[i] = 1;
+        moved_.push_back(i);
+    }
+    return {};
+}
+
+void SceneObjects::clearMoved() {
+    for (std::uint32_t i : moved_) movedFlag_[i] = 0;
+    moved_.clear();
+}
+
+}  // namespace dyncull
