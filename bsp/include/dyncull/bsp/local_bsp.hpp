@@ -16,6 +16,9 @@ namespace dyncull {
 
 inline constexpr std::uint32_t kInvalidIndex = std::numeric_limits<std::uint32_t>::max();
 
+/// Largest accepted LocalBspParams::maxDepth (bounds the builder's recursion).
+inline constexpr std::uint32_t kLocalBspMaxDepth = 64;
+
 enum class SplitMethod : std::uint8_t {
     SpatialMedian,  ///< middle of the longest axis of the node box (the two-level paper)
     Sah,            ///< surface-area heuristic over triangle barycentres (p-HBVO cost)
@@ -23,7 +26,7 @@ enum class SplitMethod : std::uint8_t {
 
 struct LocalBspParams {
     std::uint32_t maxLeafTriangles = 4000;  ///< stop splitting at or below this many triangles
-    std::uint32_t maxDepth = 16;            ///< root has depth 0
+    std::uint32_t maxDepth = 16;            ///< root has depth 0; at most kLocalBspMaxDepth
     SplitMethod method = SplitMethod::SpatialMedian;
     /// Search window, as a fraction of the node extent along the split axis, in which the
     /// plane may be nudged to cut fewer triangles (0 disables nudging).
@@ -52,6 +55,10 @@ struct LocalBspStats {
     std::size_t trianglesAfter = 0;  ///< after clipping and re-triangulation
     std::uint32_t leaves = 0;
     std::uint32_t depth = 0;  ///< deepest leaf depth
+    /// Leaves left above maxLeafTriangles (below maxDepth) because no plane on any axis
+    /// made progress, i.e. gave both children fewer triangles than the node (degenerate
+    /// input: identical, stacked or mostly-cut triangles).
+    std::uint32_t stalledLeaves = 0;
     double buildMs = 0.0;
 };
 
