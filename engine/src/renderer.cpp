@@ -134,6 +134,8 @@ void Renderer::endFrame() {
     context_.checkErrors();
 }
 
+void Renderer::finish() const { glFinish(); }
+
 Image Renderer::readPixels() const {
     Image img;
     const glm::ivec2 size = context_.size();

@@ -64,6 +64,8 @@ public:
     void drawBoxDepthTestOnly(const Aabb& box, const glm::mat4& model = glm::mat4(1.0f));
     /// Flushes and counts GL errors into the context.
     void endFrame();
+    /// Blocks until the GPU has finished all submitted work (for honest timings).
+    void finish() const;
 
     /// Reads the context framebuffer as a top-down RGBA8 image (waits for the GPU).
     Image readPixels() const;
