@@ -1,0 +1,37 @@
+// Helpers shared by CLI subcommands: option parsing, timing, error exit.
+#pragma once
+
+#include <chrono>
+#include <filesystem>
+#include <string>
+
+#include <glm/glm.hpp>
+
+#include "dyncull/objects/error.hpp"
+
+namespace dyncull::cli {
+
+/// Parses "WxH" (e.g. "1280x720"), each side in 1..16384. Error names the option.
+Expected<glm::ivec2> parseSize(const std::string& text, const std::string& optionName);
+
+/// Creates the parent directory of `file` if needed. Error names the directory.
+Status ensureParentDirectory(const std::filesystem::path& file);
+
+/// Prints "error: <message>" on stderr and exits the subcommand with code 1.
+[[noreturn]] void fail(const std::string& message);
+
+/// Milliseconds since construction or the last lap().
+class Stopwatch {
+public:
+    double lap() {
+        const auto now = std::chrono::steady_clock::now();
+        const double ms = std::chrono::duration<double, std::milli>(now - start_).count();
+        start_ = now;
+        return ms;
+    }
+
+private:
+    std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+}  // namespace dyncull::cli

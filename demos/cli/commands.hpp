@@ -1,0 +1,12 @@
+// Subcommands of the `dyncull` CLI. Each registerX adds its subcommand to the app; the
+// subcommand's callback throws CLI::RuntimeError(code) to exit non-zero after printing
+// its own one-line "error: ..." to stderr.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace dyncull::cli {
+
+void registerView(CLI::App& app);
+
+}  // namespace dyncull::cli

@@ -1,0 +1,12 @@
+// dyncull: command-line front end. Subcommands live in cmd_<name>.cpp.
+#include <CLI/CLI.hpp>
+
+#include "commands.hpp"
+
+int main(int argc, char** argv) {
+    CLI::App app{"dyncull: occlusion culling for dynamic scenes (two-level BSP + occlusion queries)"};
+    app.require_subcommand(1);
+    dyncull::cli::registerView(app);
+    CLI11_PARSE(app, argc, argv);
+    return 0;
+}
