@@ -1,0 +1,325 @@
+// glTF 2.0 loading (.gltf and .glb) through tinygltf. tinygltf parses JSON and buffers;
+// we read accessors ourselves (byteStride, every component type, bounds checks), merge a
+// mesh's triangle primitives into one dyncull Mesh and walk the node hierarchy.
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <exception>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/gtc/quaternion.hpp>
+#include <tiny_gltf.h>
+
+#include "dyncull/objects/loaders.hpp"
+#include "dyncull/objects/transform.hpp"
+#include "loader_common.hpp"
+
+namespace dyncull {
+namespace {
+
+struct Fail {
+    std::string what;
+};
+
+// Images are irrelevant for culling; skipping them also means a missing texture file
+// does not fail the load.
+bool ignoreImage(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+    return true;
+}
+
+// A validated view of an accessor's bytes.
+struct AccessorView {
+    const unsigned char* base = nullptr;
+    std::size_t stride = 0;
+    std::size_t count = 0;
+    int componentType = 0;
+    int components = 0;
+    bool normalized = false;
+};
+
+std::optional<Fail> viewAccessor(const tinygltf::Model& model, int index, int wantComponents, AccessorView& out) {
+    const std::string where = "accessor " + std::to_string(index);
+    if (index < 0 || static_cast<std::size_t>(index) >= model.accessors.size()) return Fail{where + " does not exist"};
+    const tinygltf::Accessor& a = model.accessors[static_cast<std::size_t>(index)];
+    if (a.sparse.isSparse) return Fail{where + ": sparse accessors are not supported"};
+    if (a.bufferView < 0 || static_cast<std::size_t>(a.bufferView) >= model.bufferViews.size())
+        return Fail{where + ": no valid bufferView"};
+    const tinygltf::BufferView& bv = model.bufferViews[static_cast<std::size_t>(a.bufferView)];
+    if (bv.buffer < 0 || static_cast<std::size_t>(bv.buffer) >= model.buffers.size())
+        return Fail{where + ": bufferView refers to a missing buffer"};
+    const tinygltf::Buffer& buf = model.buffers[static_cast<std::size_t>(bv.buffer)];
+    const int compSize = tinygltf::GetComponentSizeInBytes(static_cast<std::uint32_t>(a.componentType));
+    const int comps = tinygltf::GetNumComponentsInType(static_cast<std::uint32_t>(a.type));
+    if (compSize <= 0 || comps <= 0) return Fail{where + ": unknown component type or element type"};
+    if (comps != wantComponents)
+        return Fail{where + ": has " + std::to_string(comps) + " components, expected " + std::to_string(wantComponents)};
+    const std::size_t elemSize = static_cast<std::size_t>(compSize) * static_cast<std::size_t>(comps);
+    const std::size_t stride = bv.byteStride ? bv.byteStride : elemSize;
+    if (stride < elemSize) return Fail{where + ": byteStride " + std::to_string(stride) + " smaller than an element"};
+    // The last element must lie inside both the buffer view and the buffer.
+    const std::size_t need = a.count == 0 ? 0 : a.byteOffset + stride * (a.count - 1) + elemSize;
+    if (a.count > 0 && (stride * (a.count - 1) / stride != a.count - 1 || need > bv.byteLength))
+        return Fail{where + ": reads past the end of its bufferView"};
+    if (bv.byteOffset + bv.byteLength > buf.data.size())
+        return Fail{"bufferView " + std::to_string(a.bufferView) + ": reads past the end of its buffer (" +
+                    std::to_string(buf.data.size()) + " bytes)"};
+    out.base = buf.data.data() + bv.byteOffset + a.byteOffset;
+    out.stride = stride;
+    out.count = a.count;
+    out.componentType = a.componentType;
+    out.components = comps;
+    out.normalized = a.normalized;
+    return std::nullopt;
+}
+
+template <class T>
+T loadRaw(const unsigned char* p) {
+    T v;
+    std::memcpy(&v, p, sizeof(T));  // glTF data is little-endian, as is every host we build for
+    return v;
+}
+
+// Component `c` of element `i` as float, applying glTF's normalised-integer rules.
+float readFloat(const AccessorView& v, std::size_t i, int c) {
+    const unsigned char* p = v.base + i * v.stride;
+    switch (v.componentType) {
+        case TINYGLTF_COMPONENT_TYPE_FLOAT: return loadRaw<float>(p + 4 * c);
+        case TINYGLTF_COMPONENT_TYPE_BYTE: {
+            const float x = loadRaw<std::int8_t>(p + c);
+            return v.normalized ? std::max(x / 127.0f, -1.0f) : x;
+        }
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: {
+            const float x = loadRaw<std::uint8_t>(p + c);
+            return v.normalized ? x / 255.0f : x;
+        }
+        case TINYGLTF_COMPONENT_TYPE_SHORT: {
+            const float x = loadRaw<std::int16_t>(p + 2 * c);
+            return v.normalized ? std::max(x / 32767.0f, -1.0f) : x;
+        }
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+            const float x = loadRaw<std::uint16_t>(p + 2 * c);
+            return v.normalized ? x / 65535.0f : x;
+        }
+        case TINYGLTF_COMPONENT_TYPE_INT: return static_cast<float>(loadRaw<std::int32_t>(p + 4 * c));
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return static_cast<float>(loadRaw<std::uint32_t>(p + 4 * c));
+        case TINYGLTF_COMPONENT_TYPE_DOUBLE: return static_cast<float>(loadRaw<double>(p + 8 * c));
+    }
+    return 0.0f;
+}
+
+// Index element `i` as a signed 64-bit value (negative means invalid); floats rejected by caller.
+std::int64_t readIndex(const AccessorView& v, std::size_t i) {
+    const unsigned char* p = v.base + i * v.stride;
+    switch (v.componentType) {
+        case TINYGLTF_COMPONENT_TYPE_BYTE: return loadRaw<std::int8_t>(p);
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return loadRaw<std::uint8_t>(p);
+        case TINYGLTF_COMPONENT_TYPE_SHORT: return loadRaw<std::int16_t>(p);
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return loadRaw<std::uint16_t>(p);
+        case TINYGLTF_COMPONENT_TYPE_INT: return loadRaw<std::int32_t>(p);
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return loadRaw<std::uint32_t>(p);
+    }
+    return -1;
+}
+
+std::optional<Fail> readVec3(const tinygltf::Model& model, int accessor, std::vector<glm::vec3>& out) {
+    AccessorView v;
+    if (auto f = viewAccessor(model, accessor, 3, v)) return f;
+    out.resize(v.count);
+    for (std::size_t i = 0; i < v.count; ++i) out[i] = {readFloat(v, i, 0), readFloat(v, i, 1), readFloat(v, i, 2)};
+    return std::nullopt;
+}
+
+// Appends one primitive to `mesh` (vertices offset by the current vertex count).
+// Returns false in `used` for primitives that are not surfaces (points, lines).
+std::optional<Fail> appendPrimitive(const tinygltf::Model& model, const tinygltf::Primitive& prim, Mesh& mesh,
+                                    bool& allNormals, bool& used) {
+    used = false;
+    const int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+    if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN)
+        return std::nullopt;
+    const auto posIt = prim.attributes.find("POSITION");
+    if (posIt == prim.attributes.end()) return std::nullopt;  // nothing to place (allowed by the spec)
+
+    std::vector<glm::vec3> pos, nrm;
+    if (auto f = readVec3(model, posIt->second, pos)) return Fail{"POSITION " + f->what};
+    const auto nIt = prim.attributes.find("NORMAL");
+    if (nIt != prim.attributes.end()) {
+        if (auto f = readVec3(model, nIt->second, nrm)) return Fail{"NORMAL " + f->what};
+        if (nrm.size() != pos.size()) return Fail{"NORMAL count differs from POSITION count"};
+    }
+    for (std::size_t i = 0; i < pos.size(); ++i)
+        if (!std::isfinite(pos[i].x) || !std::isfinite(pos[i].y) || !std::isfinite(pos[i].z))
+            return Fail{"vertex " + std::to_string(i) + " has a non-finite coordinate"};
+
+    std::vector<std::uint32_t> idx;
+    if (prim.indices >= 0) {
+        AccessorView v;
+        if (auto f = viewAccessor(model, prim.indices, 1, v)) return Fail{"indices " + f->what};
+        if (v.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT || v.componentType == TINYGLTF_COMPONENT_TYPE_DOUBLE)
+            return Fail{"indices accessor " + std::to_string(prim.indices) + " has a floating-point type"};
+        idx.resize(v.count);
+        for (std::size_t i = 0; i < v.count; ++i) {
+            const std::int64_t k = readIndex(v, i);
+            if (k < 0 || static_cast<std::uint64_t>(k) >= pos.size())
+                return Fail{"index " + std::to_string(k) + " at position " + std::to_string(i) + " out of range (" +
+                            std::to_string(pos.size()) + " vertices)"};
+            idx[i] = static_cast<std::uint32_t>(k);
+        }
+    } else {
+        idx.resize(pos.size());
+        for (std::size_t i = 0; i < idx.size(); ++i) idx[i] = static_cast<std::uint32_t>(i);
+    }
+
+    const auto base = static_cast<std::uint32_t>(mesh.positions.size());
+    auto tri = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+        mesh.indices.push_back(base + a);
+        mesh.indices.push_back(base + b);
+        mesh.indices.push_back(base + c);
+    };
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+        if (idx.size() % 3 != 0) return Fail{"triangle list index count " + std::to_string(idx.size()) + " is not a multiple of 3"};
+        for (std::size_t i = 0; i + 2 < idx.size(); i += 3) tri(idx[i], idx[i + 1], idx[i + 2]);
+    } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+        // Every other strip triangle swaps its first two corners to keep the winding.
+        for (std::size_t i = 0; i + 2 < idx.size(); ++i)
+            if (i % 2 == 0) tri(idx[i], idx[i + 1], idx[i + 2]);
+            else tri(idx[i + 1], idx[i], idx[i + 2]);
+    } else {
+        for (std::size_t i = 1; i + 1 < idx.size(); ++i) tri(idx[0], idx[i], idx[i + 1]);
+    }
+    mesh.positions.insert(mesh.positions.end(), pos.begin(), pos.end());
+    if (nrm.empty()) allNormals = false;
+    else if (allNormals) mesh.normals.insert(mesh.normals.end(), nrm.begin(), nrm.end());
+    used = true;
+    return std::nullopt;
+}
+
+std::optional<Fail> buildMesh(const tinygltf::Model& model, int meshIndex, Mesh& mesh) {
+    const tinygltf::Mesh& src = model.meshes[static_cast<std::size_t>(meshIndex)];
+    mesh.name = src.name.empty() ? "mesh " + std::to_string(meshIndex) : src.name;
+    bool allNormals = true;
+    for (std::size_t p = 0; p < src.primitives.size(); ++p) {
+        bool used = false;
+        if (auto f = appendPrimitive(model, src.primitives[p], mesh, allNormals, used))
+            return Fail{"mesh " + std::to_string(meshIndex) + " primitive " + std::to_string(p) + ": " + f->what};
+    }
+    if (!allNormals) mesh.normals.clear();
+    if (mesh.indices.empty()) return std::nullopt;  // no surfaces: caller skips it
+    if (std::string problem = detail::finishMesh(mesh); !problem.empty())
+        return Fail{"mesh " + std::to_string(meshIndex) + ": " + problem};
+    return std::nullopt;
+}
+
+glm::mat4 localMatrix(const tinygltf::Node& n) {
+    if (n.matrix.size() == 16) {
+        glm::mat4 m;
+        for (int c = 0; c < 4; ++c)
+            for (int r = 0; r < 4; ++r) m[c][r] = static_cast<float>(n.matrix[static_cast<std::size_t>(4 * c + r)]);
+        return m;  // glTF matrices are column-major, like glm
+    }
+    glm::mat4 m(1.0f);
+    if (n.scale.size() == 3) {
+        m[0][0] = static_cast<float>(n.scale[0]);
+        m[1][1] = static_cast<float>(n.scale[1]);
+        m[2][2] = static_cast<float>(n.scale[2]);
+    }
+    if (n.rotation.size() == 4) {
+        // glTF stores (x, y, z, w); glm::quat's constructor takes (w, x, y, z).
+        const glm::quat q(static_cast<float>(n.rotation[3]), static_cast<float>(n.rotation[0]),
+                          static_cast<float>(n.rotation[1]), static_cast<float>(n.rotation[2]));
+        m = glm::mat4_cast(q) * m;
+    }
+    if (n.translation.size() == 3)
+        m[3] = glm::vec4(static_cast<float>(n.translation[0]), static_cast<float>(n.translation[1]),
+                         static_cast<float>(n.translation[2]), 1.0f);
+    return m;
+}
+
+Expected<Scene> loadGltfImpl(const std::filesystem::path& path) {
+    if (Status s = detail::checkFile(path); !s) return Error{s.message()};
+    tinygltf::TinyGLTF loader;
+    loader.SetImageLoader(ignoreImage, nullptr);
+    tinygltf::Model model;
+    std::string err, warn;
+    std::string ext = path.extension().string();
+    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    const bool ok = ext == ".glb" ? loader.LoadBinaryFromFile(&model, &err, &warn, path.string())
+                                  : loader.LoadASCIIFromFile(&model, &err, &warn, path.string());
+    if (!ok) return detail::fileError(path, err.empty() ? "cannot parse glTF" : err);
+    if (model.meshes.empty()) return detail::fileError(path, "no meshes");
+
+    // Roots: the default scene, else scene 0, else every node that is nobody's child.
+    std::vector<int> roots;
+    if (!model.scenes.empty()) {
+        const int s = model.defaultScene >= 0 && static_cast<std::size_t>(model.defaultScene) < model.scenes.size()
+                          ? model.defaultScene : 0;
+        roots = model.scenes[static_cast<std::size_t>(s)].nodes;
+    } else {
+        std::vector<char> isChild(model.nodes.size(), 0);
+        for (const tinygltf::Node& n : model.nodes)
+            for (int c : n.children)
+                if (c >= 0 && static_cast<std::size_t>(c) < model.nodes.size()) isChild[static_cast<std::size_t>(c)] = 1;
+        for (std::size_t i = 0; i < model.nodes.size(); ++i)
+            if (!isChild[i]) roots.push_back(static_cast<int>(i));
+    }
+
+    Scene scene;
+    constexpr std::uint32_t kNotLoaded = 0xFFFFFFFFu, kEmpty = 0xFFFFFFFEu;
+    std::vector<std::uint32_t> meshSlot(model.meshes.size(), kNotLoaded);  // glTF mesh -> Scene mesh
+    std::vector<char> visited(model.nodes.size(), 0);
+    struct Item {
+        int node;
+        glm::mat4 parent;
+    };
+    std::vector<Item> stack;
+    for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, glm::mat4(1.0f)});
+    while (!stack.empty()) {
+        const Item item = stack.back();
+        stack.pop_back();
+        if (item.node < 0 || static_cast<std::size_t>(item.node) >= model.nodes.size())
+            return detail::fileError(path, "node " + std::to_string(item.node) + " does not exist");
+        const auto ni = static_cast<std::size_t>(item.node);
+        // glTF nodes form a forest: a second visit means a cycle or a shared child.
+        if (visited[ni]) return detail::fileError(path, "node " + std::to_string(item.node) + " is reached twice (cycle in the node hierarchy)");
+        visited[ni] = 1;
+        const tinygltf::Node& node = model.nodes[ni];
+        const glm::mat4 world = item.parent * localMatrix(node);
+        if (node.mesh >= 0) {
+            if (static_cast<std::size_t>(node.mesh) >= model.meshes.size())
+                return detail::fileError(path, "node " + std::to_string(item.node) + ": mesh " + std::to_string(node.mesh) + " does not exist");
+            std::uint32_t& slot = meshSlot[static_cast<std::size_t>(node.mesh)];
+            if (slot == kNotLoaded) {
+                Mesh mesh;
+                if (auto f = buildMesh(model, node.mesh, mesh)) return detail::fileError(path, f->what);
+                if (mesh.indices.empty()) {
+                    slot = kEmpty;
+                } else {
+                    slot = static_cast<std::uint32_t>(scene.meshes.size());
+                    scene.meshes.push_back(std::move(mesh));
+                }
+            }
+            if (slot != kEmpty) {
+                if (Status s = validateMatrix(world); !s)
+                    return detail::fileError(path, "node " + std::to_string(item.node) + ": " + s.message());
+                scene.instances.push_back(Instance{slot, world, node.name.empty() ? "node " + std::to_string(item.node) : node.name});
+            }
+        }
+        for (auto c = node.children.rbegin(); c != node.children.rend(); ++c) stack.push_back({*c, world});
+    }
+    if (scene.instances.empty()) return detail::fileError(path, "the scene has no node with a triangle mesh");
+    return scene;
+}
+
+}  // namespace
+
+Expected<Scene> loadGltf(const std::filesystem::path& path) {
+    try {
+        return loadGltfImpl(path);
+    } catch (const std::exception& e) {
+        return detail::fileError(path, std::string("cannot load: ") + e.what());
+    }
+}
+
+}  // namespace dyncull
