@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
@@ -350,19 +351,21 @@ TEST(LocalBsp, BunnyDefaultsMatchThePaper) {
     Mesh mesh;
     ASSERT_TRUE(readAsciiPly(path, mesh));
     ASSERT_EQ(mesh.triangleCount(), 69451u);
-    const LocalBspParams p;
-    const LocalBsp bsp = buildOk(mesh, p);
-    checkInvariants(bsp, p);
-    expectAreaConserved(mesh, bsp);
-    EXPECT_GE(bsp.stats.leaves, 20u);
-    EXPECT_LE(bsp.stats.leaves, 30u);
-    EXPECT_LE(double(bsp.stats.trianglesAfter), 1.12 * double(bsp.stats.trianglesBefore));
-    RecordProperty("leaves", int(bsp.stats.leaves));
-    RecordProperty("trianglesAfter", int(bsp.stats.trianglesAfter));
-    std::printf("bunny: %u leaves, %zu -> %zu triangles (+%.1f%%), depth %u, %.1f ms\n", bsp.stats.leaves,
-                bsp.stats.trianglesBefore, bsp.stats.trianglesAfter,
-                100.0 * (double(bsp.stats.trianglesAfter) / double(bsp.stats.trianglesBefore) - 1.0),
-                bsp.stats.depth, bsp.stats.buildMs);
+    for (const SplitMethod method : {SplitMethod::SpatialMedian, SplitMethod::Sah}) {
+        LocalBspParams p;
+        p.method = method;
+        const LocalBsp bsp = buildOk(mesh, p);
+        checkInvariants(bsp, p);
+        expectAreaConserved(mesh, bsp);
+        EXPECT_GE(bsp.stats.leaves, 20u);
+        EXPECT_LE(bsp.stats.leaves, 30u);
+        EXPECT_LE(double(bsp.stats.trianglesAfter), 1.12 * double(bsp.stats.trianglesBefore));
+        std::printf("bunny %s: %u leaves, %zu -> %zu triangles (+%.1f%%), depth %u, %.1f ms\n",
+                    method == SplitMethod::Sah ? "sah" : "median", bsp.stats.leaves, bsp.stats.trianglesBefore,
+                    bsp.stats.trianglesAfter,
+                    100.0 * (double(bsp.stats.trianglesAfter) / double(bsp.stats.trianglesBefore) - 1.0),
+                    bsp.stats.depth, bsp.stats.buildMs);
+    }
 }
 
 }  // namespace

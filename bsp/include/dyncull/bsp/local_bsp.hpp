@@ -24,8 +24,10 @@ enum class SplitMethod : std::uint8_t {
     Sah,            ///< surface-area heuristic over triangle barycentres (p-HBVO cost)
 };
 
+/// Defaults tuned on the Stanford bunny (69,451 triangles): 24 leaves, +9.6% triangles
+/// with SpatialMedian (22 leaves, +9.6% with Sah); the paper reports 23 parts, +10%.
 struct LocalBspParams {
-    std::uint32_t maxLeafTriangles = 4000;  ///< stop splitting at or below this many triangles
+    std::uint32_t maxLeafTriangles = 5000;  ///< stop splitting at or below this many triangles
     std::uint32_t maxDepth = 16;            ///< root has depth 0; at most kLocalBspMaxDepth
     SplitMethod method = SplitMethod::SpatialMedian;
     /// Search window, as a fraction of the node extent along the split axis, in which the
@@ -38,8 +40,11 @@ struct LocalBspParams {
 /// subtree form one contiguous range [firstIndex, firstIndex + indexCount) of
 /// LocalBsp::mesh.indices, so a leaf — or a whole visible subtree — is one draw call.
 struct LocalBspNode {
-    Aabb box;  ///< tight object-space box of the node's (clipped) triangles
-    std::uint32_t children[2] = {kInvalidIndex, kInvalidIndex};  ///< [below, above] the plane; invalid for leaves
+    Aabb box;  ///< tight object-space box of the subtree's (clipped) triangles; empty for an empty mesh
+    /// [below, above] the plane; invalid for leaves. children[0] == self + 1 always. A vertex
+    /// within a tiny band around the plane (1e-5 of the node size) counts as on it, so a
+    /// child's box may reach past `split` by that much; triangles in the plane go below.
+    std::uint32_t children[2] = {kInvalidIndex, kInvalidIndex};
     std::uint32_t firstIndex = 0;  ///< into LocalBsp::mesh.indices
     std::uint32_t indexCount = 0;  ///< 3 x triangles of the whole subtree
     std::uint32_t subtreeSize = 1;  ///< nodes in this subtree including itself
@@ -73,7 +78,14 @@ struct LocalBsp {
     bool hasTree() const { return nodes.size() > 1; }
 };
 
-/// Builds the BSP. Errors (never asserts) for invalid meshes or parameters.
+/// Builds the BSP of `mesh` (object space; not modified, not retained). The result owns
+/// a copy of the mesh with every original vertex kept at its index, new vertices appended
+/// where edges cross split planes (normals interpolated, or computed first when the input
+/// has none), and indices reordered by leaf. Splitting stops at maxLeafTriangles, at
+/// maxDepth, or when no plane gives both children fewer triangles (stats.stalledLeaves).
+/// Errors (never asserts) for an invalid mesh (validateMesh) or parameters:
+/// maxLeafTriangles == 0, maxDepth > kLocalBspMaxDepth, nudgeFraction not in [0, 0.5].
+/// An empty mesh gives a single empty leaf.
 Expected<LocalBsp> buildLocalBsp(const Mesh& mesh, const LocalBspParams& params = {});
 
 }  // namespace dyncull
