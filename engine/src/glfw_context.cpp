@@ -73,7 +73,9 @@ Expected<std::unique_ptr<GlContext>> createGlfwContext(const ContextOptions& o) 
     glfwGetFramebufferSize(ctx->window_, &w, &h);
     ctx->size_ = {w, h};
     ctx->framebuffer_ = 0;
-    ctx->platform_ = std::string("GLFW ") + glfwGetVersionString();
+    int vmaj = 0, vmin = 0, vrev = 0;
+    glfwGetVersion(&vmaj, &vmin, &vrev);
+    ctx->platform_ = "GLFW " + std::to_string(vmaj) + "." + std::to_string(vmin) + "." + std::to_string(vrev) + " window";
     ctx->initCommon(o.debug);
     return std::unique_ptr<GlContext>(std::move(ctx));
 }
