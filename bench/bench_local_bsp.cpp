@@ -4,12 +4,11 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <numbers>
-#include <sstream>
 #include <string>
 
 #include "dyncull/bsp/local_bsp.hpp"
+#include "dyncull/objects/loaders.hpp"
 
 namespace {
 
@@ -37,42 +36,12 @@ Mesh sphereMesh(int slices, int stacks) {
     return m;
 }
 
-// Minimal ASCII PLY reader (x y z first on each vertex line, triangle faces).
-bool readAsciiPly(const std::filesystem::path& path, Mesh& mesh) {
-    std::ifstream in(path);
-    std::string line, word;
-    std::size_t nv = 0, nf = 0;
-    while (std::getline(in, line) && line != "end_header") {
-        std::istringstream ls(line);
-        ls >> word;
-        if (word == "element") {
-            std::string kind;
-            std::size_t n = 0;
-            ls >> kind >> n;
-            (kind == "vertex" ? nv : nf) = n;
-        }
-    }
-    for (std::size_t i = 0; i < nv && std::getline(in, line); ++i) {
-        glm::vec3 p;
-        std::istringstream(line) >> p.x >> p.y >> p.z;
-        mesh.positions.push_back(p);
-    }
-    for (std::size_t i = 0; i < nf; ++i) {
-        std::uint32_t k = 0, a = 0, b = 0, c = 0;
-        if (!(in >> k >> a >> b >> c) || k != 3) return false;
-        mesh.indices.insert(mesh.indices.end(), {a, b, c});
-    }
-    if (!in || !validateMesh(mesh).empty()) return false;
-    computeNormals(mesh);  // as the real loader does, so the build does not time it
-    return true;
-}
-
 const Mesh* bunny() {
     static const Mesh mesh = [] {
-        Mesh m;
         const std::filesystem::path path = std::filesystem::path(DYNCULL_BENCH_DATA_DIR) / "bun_zipper.ply";
-        if (!std::filesystem::exists(path) || !readAsciiPly(path, m)) m = Mesh{};
-        return m;
+        if (!std::filesystem::exists(path)) return Mesh{};
+        Expected<Scene> scene = loadScene(path);  // has normals, so the build does not time them
+        return scene.ok() && scene->meshes.size() == 1 ? scene->meshes[0] : Mesh{};
     }();
     return mesh.indices.empty() ? nullptr : &mesh;
 }

@@ -6,12 +6,11 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <numbers>
-#include <sstream>
 #include <string>
 
 #include "dyncull/bsp/local_bsp.hpp"
+#include "dyncull/objects/loaders.hpp"
 
 namespace dyncull {
 namespace {
@@ -317,39 +316,13 @@ TEST(LocalBsp, BadInputIsAnError) {
     EXPECT_NE(r.error().message.find("maxDepth"), std::string::npos);
 }
 
-// Minimal ASCII PLY reader for the bunny (x y z first on each vertex line).
-bool readAsciiPly(const std::filesystem::path& path, Mesh& mesh) {
-    std::ifstream in(path);
-    std::string line, word;
-    std::size_t nv = 0, nf = 0;
-    while (std::getline(in, line) && line != "end_header") {
-        std::istringstream ls(line);
-        ls >> word;
-        if (word == "element") {
-            std::string kind;
-            std::size_t n = 0;
-            ls >> kind >> n;
-            (kind == "vertex" ? nv : nf) = n;
-        }
-    }
-    for (std::size_t i = 0; i < nv && std::getline(in, line); ++i) {
-        glm::vec3 p;
-        std::istringstream(line) >> p.x >> p.y >> p.z;
-        mesh.positions.push_back(p);
-    }
-    for (std::size_t i = 0; i < nf; ++i) {
-        std::uint32_t k = 0, a = 0, b = 0, c = 0;
-        if (!(in >> k >> a >> b >> c) || k != 3) return false;
-        mesh.indices.insert(mesh.indices.end(), {a, b, c});
-    }
-    return bool(in) && validateMesh(mesh).empty();
-}
-
 TEST(LocalBsp, BunnyDefaultsMatchThePaper) {
     const std::filesystem::path path = std::filesystem::path(DYNCULL_TEST_DATA_DIR) / "bun_zipper.ply";
     if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not present";
-    Mesh mesh;
-    ASSERT_TRUE(readAsciiPly(path, mesh));
+    Expected<Scene> scene = loadScene(path);
+    ASSERT_TRUE(scene.ok()) << scene.error().message;
+    ASSERT_EQ(scene->meshes.size(), 1u);
+    const Mesh& mesh = scene->meshes[0];
     ASSERT_EQ(mesh.triangleCount(), 69451u);
     for (const SplitMethod method : {SplitMethod::SpatialMedian, SplitMethod::Sah}) {
         LocalBspParams p;
