@@ -1,0 +1,95 @@
+#include <cmath>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "bsp_test_models.hpp"
+#include "dyncull/bsp/scene_objects.hpp"
+
+using namespace dyncull;
+
+namespace {
+
+Transform at(glm::vec3 p, float s = 1.0f) {
+    Transform t;
+    t.translation = p;
+    t.scale = glm::vec3(s);
+    return t;
+}
+
+}  // namespace
+
+TEST(SceneObjects, AddComputesMatrixAndWorldBox) {
+    SceneObjects so;
+    const ModelId m = so.addModel(test::cubeModel());
+    Transform t = at({10.0f, 0.0f, 0.0f}, 2.0f);
+    auto h = so.addObject(m, t);
+    ASSERT_TRUE(h.ok());
+    EXPECT_EQ(so.objectCount(), 1u);
+    const Aabb& b = so.worldBox(h->index);
+    EXPECT_FLOAT_EQ(b.min.x, 9.0f);
+    EXPECT_FLOAT_EQ(b.max.x, 11.0f);
+    EXPECT_FLOAT_EQ(b.max.y, 1.0f);
+    EXPECT_EQ(so.added().size(), 1u);
+    EXPECT_TRUE(so.moved().empty());
+}
+
+TEST(SceneObjects, UnknownModelAndBadTransformAreErrors) {
+    SceneObjects so;
+    auto bad = so.addObject(3, Transform{});
+    ASSERT_FALSE(bad.ok());
+    EXPECT_NE(bad.error().message.find("unknown model"), std::string::npos);
+    const ModelId m = so.addModel(test::cubeModel());
+    Transform nanT = at({std::nanf(""), 0, 0});
+    EXPECT_FALSE(so.addObject(m, nanT).ok());
+    Transform zero = at({0, 0, 0}, 0.0f);
+    EXPECT_FALSE(so.addObject(m, zero).ok());
+    EXPECT_EQ(so.objectCount(), 0u);
+    EXPECT_EQ(so.slotCount(), 0u);  // nothing half-added
+}
+
+TEST(SceneObjects, SetTransformMarksMovedOnceAndRejectsBadInputWithoutChange) {
+    SceneObjects so;
+    const ModelId m = so.addModel(test::cubeModel());
+    ObjectHandle h = so.addObject(m, at({0, 0, 0})).take();
+    ASSERT_TRUE(so.setTransform(h, at({1, 0, 0})).ok());
+    ASSERT_TRUE(so.setTransform(h, at({2, 0, 0})).ok());
+    EXPECT_EQ(so.moved().size(), 1u);
+    EXPECT_FLOAT_EQ(so.worldBox(h.index).center().x, 2.0f);
+    Transform inf = at({0, 0, 0}, std::numeric_limits<float>::infinity());
+    Status s = so.setTransform(h, inf);
+    EXPECT_FALSE(s.ok());
+    EXPECT_NE(s.message().find("setTransform"), std::string::npos);
+    EXPECT_FLOAT_EQ(so.worldBox(h.index).center().x, 2.0f);  // unchanged
+    Transform huge = at({3e38f, 0, 0}, 1e38f);  // finite inputs, box max overflows float
+    EXPECT_FALSE(so.setTransform(h, huge).ok());
+    so.clearMoved();
+    EXPECT_TRUE(so.moved().empty());
+    ASSERT_TRUE(so.setTransform(h, at({3, 0, 0})).ok());
+    EXPECT_EQ(so.moved().size(), 1u);
+}
+
+TEST(SceneObjects, StaleHandlesAreDetectedAndSlotsReusedWithNewGeneration) {
+    SceneObjects so;
+    const ModelId m = so.addModel(test::cubeModel());
+    ObjectHandle a = so.addObject(m, at({0, 0, 0})).take();
+    ObjectHandle b = so.addObject(m, at({5, 0, 0})).take();
+    ASSERT_TRUE(so.removeObject(a).ok());
+    EXPECT_FALSE(so.alive(a));
+    EXPECT_TRUE(so.alive(b));
+    EXPECT_FALSE(so.removeObject(a).ok());
+    Status s = so.setTransform(a, at({1, 1, 1}));
+    EXPECT_FALSE(s.ok());
+    EXPECT_NE(s.message().find("stale"), std::string::npos);
+    ObjectHandle c = so.addObject(m, at({7, 0, 0})).take();
+    EXPECT_EQ(c.index, a.index);  // slot reused from the free list
+    EXPECT_EQ(c.generation, a.generation + 1);
+    EXPECT_FALSE(so.alive(a));  // old handle stays stale after reuse
+    EXPECT_TRUE(so.alive(c));
+    EXPECT_EQ(so.objectCount(), 2u);
+    EXPECT_EQ(so.slotCount(), 2u);
+    EXPECT_EQ(so.removed().size(), 1u);
+    EXPECT_EQ(so.added().size(), 3u);
+    EXPECT_FALSE(so.removeObject(ObjectHandle{}).ok());
+    EXPECT_FALSE(so.removeObject(ObjectHandle{99, 0}).ok());
+}
