@@ -175,6 +175,26 @@ TEST(GltfLoader, BinaryGlb) {
     checkHierarchyScene(*r);
 }
 
+TEST(GltfLoader, TruncatedJsonIsAnErrorNotACrash) {
+    TempDir dir;
+    const std::string full = gltfJson(embedded(bufferBytes()));
+    for (std::size_t n = 1; n < full.size(); n += 17) {
+        const auto path = dir.write("cut.gltf", full.substr(0, n));
+        auto r = loadGltf(path);
+        ASSERT_FALSE(r.ok()) << n;
+        ASSERT_EQ(r.error().message.rfind(path.string(), 0), 0u) << r.error().message;
+    }
+}
+
+TEST(GltfLoader, TruncatedBinFileIsAnError) {
+    TempDir dir;
+    dir.write("scene.bin", bufferBytes().substr(0, 100));
+    const auto path = dir.write("scene.gltf", gltfJson("scene.bin"));
+    auto r = loadGltf(path);
+    ASSERT_FALSE(r.ok());
+    EXPECT_EQ(r.error().message.rfind(path.string(), 0), 0u) << r.error().message;
+}
+
 TEST(GltfLoader, MissingFile) {
     TempDir dir;
     const auto path = dir.file("none.gltf");

@@ -147,8 +147,32 @@ TEST_P(PlyBinary, TruncatedInTheMiddleIsAnError) {
     expectError(loadPly(path), path, "truncated");
 }
 
+TEST_P(PlyBinary, EveryTruncationIsAnErrorNotACrash) {
+    TempDir dir;
+    const std::string full = binaryPly(GetParam());
+    // Step 3 (co-prime to the 2/4/8-byte fields) still cuts inside every kind of field.
+    for (std::size_t n = 1; n < full.size(); n += 3) {
+        const auto path = dir.write("cut.ply", full.substr(0, n));
+        auto r = loadPly(path);
+        ASSERT_FALSE(r.ok()) << "prefix of " << n << " bytes loaded";
+        ASSERT_EQ(r.error().message.rfind(path.string(), 0), 0u) << r.error().message;
+    }
+}
+
 INSTANTIATE_TEST_SUITE_P(Endianness, PlyBinary, ::testing::Values(false, true),
                          [](const auto& p) { return p.param ? "BigEndian" : "LittleEndian"; });
+
+TEST(PlyLoader, EveryAsciiTruncationIsHandled) {
+    TempDir dir;
+    const std::string full = kAsciiQuad;
+    for (std::size_t n = 1; n < full.size(); n += 2) {
+        const auto path = dir.write("cut.ply", full.substr(0, n));
+        auto r = loadPly(path);
+        // Cutting only the final newline (or a digit-free tail) may still be a valid file.
+        if (r.ok()) EXPECT_GE(n, full.size() - 2) << "prefix of " << n << " bytes loaded";
+        else ASSERT_EQ(r.error().message.rfind(path.string(), 0), 0u) << r.error().message;
+    }
+}
 
 TEST(PlyLoader, AllScalarTypesInAscii) {
     TempDir dir;
