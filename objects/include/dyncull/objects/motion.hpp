@@ -19,7 +19,10 @@ class BouncingMotion {
 public:
     /// `count` points with seeded start positions inside `box` and random directions at
     /// `speed` units/frame. `margin` keeps each point that far from the walls (e.g. the
-    /// object's bounding radius), so the object's box stays inside.
+    /// object's bounding radius), so the object's box stays inside; on an axis where
+    /// `margin` exceeds half the box extent the points stay at the box centre.
+    /// Precondition (asserted): `box` finite and non-empty. Uses std::mt19937_64 with our
+    /// own uniform mapping, so positions are identical across standard libraries.
     BouncingMotion(std::uint32_t count, const Aabb& box, float speed, float margin, std::uint64_t seed);
 
     std::uint32_t count() const { return static_cast<std::uint32_t>(start_.size()); }
@@ -38,8 +41,11 @@ private:
 /// look-at waypoints; frame f maps to parameter f / framesPerSegment.
 class CameraPath {
 public:
+    /// `eyes` non-empty; `targets` one per eye or a single fixed target (asserted). With
+    /// `loop` the path closes back to the first waypoint, else it stops at the last one.
     CameraPath(std::vector<glm::vec3> eyes, std::vector<glm::vec3> targets, std::uint32_t framesPerSegment, bool loop);
-    /// Circle of radius `dist` around `centre` at height `height` above it, `frames` per turn.
+    /// Circle of radius `dist` around `centre` at height `height` above it, `frames` per turn
+    /// (exact when `frames` has a divisor in [8, 64]; else rounded to a multiple of 16).
     static CameraPath orbit(const glm::vec3& centre, float dist, float height, std::uint32_t frames);
 
     /// Fills position/target of `camera` (other fields untouched) for frame `frame`.
