@@ -1,0 +1,27 @@
+// What one culled frame cost and did. Times in milliseconds of wall clock (steady_clock).
+#pragma once
+
+#include <cstdint>
+
+namespace dyncull {
+
+struct FrameStats {
+    double traversalMs = 0.0;  ///< CPU in tree update, traversal and scheduling (excludes waits and draws)
+    double waitMs = 0.0;       ///< blocked waiting for query results
+    double drawMs = 0.0;       ///< CPU time submitting parts (and query volumes)
+    double frameMs = 0.0;      ///< whole frame including the final glFinish
+    double updateMs = 0.0;     ///< loose-BSP relink and lazy rebuild
+    std::uint32_t queriesIssued = 0;
+    std::uint32_t queriesOccluded = 0;  ///< answered "occluded"
+    std::uint32_t queriesTimedOut = 0;  ///< never answered within the bound; counted visible
+    std::uint32_t skippedByHistory = 0;  ///< queries not issued thanks to visibility history
+    std::uint32_t skippedByOccupancy = 0;  ///< visible without a query: rectangle touched empty screen
+    std::uint32_t visibleNearOrInside = 0;  ///< visible without a query: camera inside / near plane crossed
+    std::uint32_t frustumCulled = 0;
+    std::uint32_t nodesVisited = 0;
+    std::uint32_t batches = 0;
+    std::uint32_t partsDrawn = 0;  ///< local-BSP leaves (object parts) drawn
+    std::uint64_t trianglesDrawn = 0;
+};
+
+}  // namespace dyncull

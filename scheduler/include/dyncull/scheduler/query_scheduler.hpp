@@ -1,0 +1,111 @@
+// Front-to-back occlusion culling of the two-level hierarchy with hardware queries:
+// the active-node list (scene and object nodes together, refined as traversal proceeds),
+// the first visibility test, visibility history, batched queries with non-overlapping
+// screen rectangles, the occupancy-map fast accept, and tightened query volumes.
+// Papers: Two-level BSP for dynamic occlusion culling, section 3.3-3.4, Algorithms 2-4;
+// Staneker et al., Efficient Multiple Occlusion Queries, sections 3-4.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "dyncull/bsp/traversal.hpp"
+#include "dyncull/objects/camera.hpp"
+#include "dyncull/objects/error.hpp"
+#include "dyncull/scheduler/frame_stats.hpp"
+#include "dyncull/scheduler/occupancy_map.hpp"
+#include "dyncull/scheduler/query_backend.hpp"
+#include "dyncull/scheduler/visibility_history.hpp"
+
+namespace dyncull {
+
+enum class CullMode : std::uint8_t {
+    Vfc,     ///< frustum culling only
+    Simple,  ///< the paper's Simple OC: one stop-and-wait query per node in the frustum
+    Full,    ///< everything below, each feature switchable for ablation
+};
+const char* toString(CullMode m);
+Expected<CullMode> parseCullMode(const std::string& s);
+
+struct SchedulerParams {
+    CullMode mode = CullMode::Full;
+    // Ablation switches for Full.
+    bool useHistory = true;
+    bool useBatching = true;
+    bool useOccupancyAccept = true;
+    bool useTightVolumes = true;
+
+    HistoryParams history;
+    std::uint32_t maxQueriesInFlight = 64;
+    int occupancyTileSize = 16;  ///< pixels per tile side of both occupancy maps
+    /// Objects that kept their transform this many frames are queried with their exact
+    /// transformed local boxes instead of world AABBs (tightened boxes).
+    std::uint32_t tightenAfterFrames = 3;
+    double queryTimeoutMs = 250.0;  ///< a result that never arrives counts as visible
+};
+
+/// Validates ranges (e.g. tile size > 0, maxQueriesInFlight > 0).
+Status validateSchedulerParams(const SchedulerParams& p);
+
+/// Runs one frame of culling and drawing. Owns the visibility history between frames;
+/// borrows the tree, backend and sink for the duration of cullFrame.
+class QueryScheduler {
+public:
+    explicit QueryScheduler(SchedulerParams params = {});
+
+    const SchedulerParams& params() const { return params_; }
+    void setParams(const SchedulerParams& p) { params_ = p; }
+
+    /// Traverses `tree` front-to-back for `camera` (world space), drawing visible parts
+    /// through `sink` and querying through `backend`. Returns the frame's counts and CPU
+    /// times (frameMs and updateMs are left for the caller, who owns glFinish and the tree update).
+    FrameStats cullFrame(const TwoLevelTree& tree, const Camera& camera, int width, int height,
+                         QueryBackend& backend, PartSink& sink);
+
+    /// Forget all history (e.g. after a camera cut).
+    void resetHistory() { history_.clear(); }
+    std::uint32_t frameIndex() const { return frame_; }
+
+private:
+    struct Pending {
+        NodeRef node;
+        QueryId id;
+        ScreenRect rect;
+        bool batchedRect;  // rect is marked in pendingMap_
+    };
+    enum class FirstTest : std::uint8_t { Invisible, Visible, NeedQuery };
+
+    FirstTest firstVisibilityTest(NodeRef ref, const Aabb& box, NodeHistory& h, FrameStats& st);
+    void processVisible(NodeRef ref, NodeHistory& h);
+    void drawNode(NodeRef ref);
+    QueryVolume queryVolume(NodeRef ref, const Aabb& worldBox) const;
+    bool projectRect(const Aabb& box, ScreenRect& out) const;
+    void finishQuery(Pending& p, QueryResult r);
+
+    void runVfc();
+    void runSimple();
+    void runFull();
+
+    SchedulerParams params_;
+    VisibilityHistory history_;
+    OccupancyMap drawnMap_, pendingMap_;
+    std::uint32_t frame_ = 0;
+    std::vector<std::uint32_t> stillSince_;  // per object slot: first frame of its current transform (seen lazily)
+    std::vector<glm::mat4> lastMatrix_;
+
+    // Per-frame borrowed state.
+    const TwoLevelTree* tree_ = nullptr;
+    QueryBackend* backend_ = nullptr;
+    PartSink* sink_ = nullptr;
+    Camera camera_;
+    glm::mat4 viewProj_{1.0f};
+    Frustum frustum_;
+    int width_ = 0, height_ = 0;
+    FrameStats* stats_ = nullptr;
+    std::vector<NodeRef> active_;   // stack: back() is the nearest unprocessed node
+    std::vector<Pending> pending_;
+    std::vector<NodeRef> scratch_;
+};
+
+}  // namespace dyncull

@@ -1,0 +1,57 @@
+// Per-node record of recent query answers, used to skip queries for nodes that were
+// visible recently: the more "visible" answers in the history, the more frames the
+// next query is postponed while the node is drawn as visible.
+// Paper: Two-level BSP for dynamic occlusion culling, section 3.4 and Figure 3.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "dyncull/bsp/traversal.hpp"
+
+namespace dyncull {
+
+struct HistoryParams {
+    /// Frames a query is postponed per "visible" answer among the last 8 queries.
+    std::uint32_t skipFramesPerVisible = 1;
+    std::uint32_t maxSkipFrames = 8;  ///< cap on the postponement
+    /// Answers needed before any skipping starts (1 = skip after one visible answer).
+    std::uint32_t minVisibleToSkip = 2;
+};
+
+/// One node's record. `bits` holds the last 8 answers (bit 0 newest, 1 = visible).
+struct NodeHistory {
+    std::uint32_t lastQueryFrame = 0;  ///< frame of the newest answer
+    std::uint32_t lastVisibleFrame = 0;  ///< last frame the node was known or assumed visible
+    std::uint32_t lastTouchedFrame = 0;  ///< last frame the traversal reached the node
+    std::uint8_t bits = 0;
+    std::uint8_t answers = 0;  ///< number of answers recorded, saturating at 8
+    bool lastVisible = false;  ///< outcome the last time the node was reached (false: never seen)
+};
+
+/// Storage for scene-tree and object-tree nodes together. Scene nodes by node index;
+/// object nodes in a per-object-slot block sized to the model's node count, reset when
+/// the slot is reused by another object (generation changed) or its model changes.
+class VisibilityHistory {
+public:
+    /// Record for `ref`, creating it (never seen: lastVisible false) if needed.
+    NodeHistory& at(NodeRef ref, const SceneObjects& objects);
+    void clear();
+
+    void recordAnswer(NodeHistory& h, bool visible, std::uint32_t frame) const;
+    /// True if the node may be drawn this frame without a query (Algorithm 3,
+    /// ExamineRecentQueryResults): it was visible last time and the postponement that its
+    /// count of visible answers earns has not run out.
+    bool canSkipQuery(const NodeHistory& h, std::uint32_t frame, const HistoryParams& p) const;
+
+    std::size_t memoryBytes() const;
+
+private:
+    std::vector<NodeHistory> scene_;
+    std::vector<NodeHistory> objectNodes_;
+    std::vector<std::uint32_t> objectBase_;  // per slot: first record, or kInvalidIndex
+    std::vector<std::uint32_t> objectGen_;   // per slot: generation the block belongs to
+    std::vector<std::uint32_t> objectModel_;
+};
+
+}  // namespace dyncull

@@ -1,0 +1,389 @@
+// Occlusion-culling scheduler over the two-level hierarchy.
+// Papers: Two-level BSP for dynamic occlusion culling (Algorithms 2-4, section 3.4);
+// Staneker, Bartz, Straßer, Efficient Multiple Occlusion Queries (sections 3-4):
+// occupancy-map fast accept and batches of queries with non-overlapping rectangles.
+#include "dyncull/scheduler/query_scheduler.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+namespace dyncull {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+}  // namespace
+
+const char* toString(CullMode m) {
+    switch (m) {
+        case CullMode::Vfc: return "vfc";
+        case CullMode::Simple: return "simple";
+        case CullMode::Full: return "full";
+    }
+    return "?";
+}
+
+Expected<CullMode> parseCullMode(const std::string& s) {
+    if (s == "vfc") return CullMode::Vfc;
+    if (s == "simple") return CullMode::Simple;
+    if (s == "full") return CullMode::Full;
+    return Error{"unknown mode '" + s + "' (expected vfc, simple or full)"};
+}
+
+Status validateSchedulerParams(const SchedulerParams& p) {
+    if (p.maxQueriesInFlight == 0) return Error{"maxQueriesInFlight must be at least 1"};
+    if (p.occupancyTileSize <= 0) return Error{"occupancyTileSize must be positive"};
+    if (!(p.queryTimeoutMs > 0.0)) return Error{"queryTimeoutMs must be positive"};
+    if (p.history.maxSkipFrames > 1000) return Error{"history.maxSkipFrames must be at most 1000"};
+    return {};
+}
+
+QueryScheduler::QueryScheduler(SchedulerParams params) : params_(params) {}
+
+FrameStats QueryScheduler::cullFrame(const TwoLevelTree& tree, const Camera& camera, int width, int height,
+                                     QueryBackend& backend, PartSink& sink) {
+    const auto t0 = Clock::now();
+    FrameStats st;
+    ++frame_;  // frame 0 is "never"; the first culled frame is 1
+    tree_ = &tree;
+    backend_ = &backend;
+    sink_ = &sink;
+    camera_ = camera;
+    viewProj_ = camera.viewProjection();
+    frustum_ = Frustum::fromMatrix(viewProj_);
+    width_ = width;
+    height_ = height;
+    stats_ = &st;
+    active_.clear();
+    pending_.clear();
+    if (drawnMap_.tilesX() * params_.occupancyTileSize < width || drawnMap_.tilesY() * params_.occupancyTileSize < height ||
+        (drawnMap_.tilesX() - 1) * params_.occupancyTileSize >= width) {
+        drawnMap_.reset(width, height, params_.occupancyTileSize);
+        pendingMap_.reset(width, height, params_.occupancyTileSize);
+    } else {
+        drawnMap_.clear();
+        pendingMap_.clear();
+    }
+    const std::uint32_t slots = tree.objects().slotCount();
+    if (stillSince_.size() < slots) {
+        stillSince_.resize(slots, frame_);
+        lastMatrix_.resize(slots, glm::mat4(0.0f));
+    }
+
+    backend.beginFrame(camera, width, height);
+    const Aabb rootBox = tree.worldBox(tree.root());
+    if (!rootBox.empty()) active_.push_back(tree.root());
+    switch (params_.mode) {
+        case CullMode::Vfc: runVfc(); break;
+        case CullMode::Simple: runSimple(); break;
+        case CullMode::Full: runFull(); break;
+    }
+    st.traversalMs = std::max(0.0, msSince(t0) - st.waitMs - st.drawMs);
+    stats_ = nullptr;
+    return st;
+}
+
+bool QueryScheduler::projectRect(const Aabb& box, ScreenRect& out) const {
+    // Project the box clipped to the near plane, so boxes crossing it still get a correct
+    // (conservative) rectangle. Returns false if the box crosses the near plane.
+    glm::vec4 clip[8];
+    bool front[8];
+    bool crosses = false;
+    for (int i = 0; i < 8; ++i) {
+        const glm::vec3 c((i & 1) ? box.max.x : box.min.x, (i & 2) ? box.max.y : box.min.y,
+                          (i & 4) ? box.max.z : box.min.z);
+        clip[i] = viewProj_ * glm::vec4(c, 1.0f);
+        front[i] = clip[i].z >= -clip[i].w;  // in front of the near plane (GL clip space)
+        crosses |= !front[i];
+    }
+    glm::vec2 lo(1e30f), hi(-1e30f);
+    auto addPoint = [&](const glm::vec4& p) {
+        // w > 0 for any point on or in front of the near plane (w = -z_view >= near > 0).
+        const glm::vec2 ndc = glm::vec2(p) / std::max(p.w, 1e-30f);
+        lo = glm::min(lo, ndc);
+        hi = glm::max(hi, ndc);
+    };
+    for (int i = 0; i < 8; ++i)
+        if (front[i]) addPoint(clip[i]);
+    if (crosses) {
+        // The 12 edges: pairs of corners differing in exactly one bit.
+        for (int i = 0; i < 8; ++i)
+            for (int bit = 1; bit < 8; bit <<= 1) {
+                const int j = i | bit;
+                if (j == i || front[i] == front[j]) continue;
+                const float di = clip[i].z + clip[i].w, dj = clip[j].z + clip[j].w;
+                const float t = di / (di - dj);
+                addPoint(clip[i] + (clip[j] - clip[i]) * t);
+            }
+    }
+    if (lo.x > hi.x) {  // nothing in front of the near plane
+        out = {};
+        return !crosses;
+    }
+    // Pixels, rounded outwards and padded by one so rasterisation rules never leave a
+    // covered pixel outside the rectangle.
+    const float fx = 0.5f * static_cast<float>(width_), fy = 0.5f * static_cast<float>(height_);
+    auto clampi = [](float v, int lim) { return static_cast<int>(std::clamp(v, 0.0f, static_cast<float>(lim))); };
+    out.x0 = clampi(std::floor((lo.x + 1.0f) * fx) - 1.0f, width_);
+    out.y0 = clampi(std::floor((lo.y + 1.0f) * fy) - 1.0f, height_);
+    out.x1 = clampi(std::ceil((hi.x + 1.0f) * fx) + 1.0f, width_);
+    out.y1 = clampi(std::ceil((hi.y + 1.0f) * fy) + 1.0f, height_);
+    return !crosses;
+}
+
+QueryScheduler::FirstTest QueryScheduler::firstVisibilityTest(NodeRef ref, const Aabb& box, NodeHistory& h,
+                                                             FrameStats& st) {
+    // Algorithm 3.
+    if (frustum_.outside(box)) {
+        ++st.frustumCulled;
+        h.lastVisible = false;
+        return FirstTest::Invisible;
+    }
+    ScreenRect rect;
+    const bool inFront = projectRect(box, rect);
+    if (!inFront || box.contains(camera_.position)) {
+        // Camera inside or box crossing the near plane: a query could be clipped away
+        // and wrongly answer "occluded", so such a node is always visible.
+        ++st.visibleNearOrInside;
+        return FirstTest::Visible;
+    }
+    if (rect.empty()) {
+        // Passed the conservative plane test but projects to no pixel of the viewport.
+        ++st.frustumCulled;
+        h.lastVisible = false;
+        return FirstTest::Invisible;
+    }
+    (void)ref;
+    if (params_.mode == CullMode::Full && params_.useHistory &&
+        history_.canSkipQuery(h, frame_, params_.history)) {
+        ++st.skippedByHistory;
+        return FirstTest::Visible;
+    }
+    return FirstTest::NeedQuery;
+}
+
+QueryVolume QueryScheduler::queryVolume(NodeRef ref, const Aabb& worldBox) const {
+    if (ref.isSceneNode() || params_.mode != CullMode::Full || !params_.useTightVolumes) return QueryVolume::fromAabb(worldBox);
+    // Tightened box: the object's exact transformed local box instead of its world AABB,
+    // once the object has kept its transform for a few frames.
+    if (frame_ - stillSince_[ref.object] < params_.tightenAfterFrames) return QueryVolume::fromAabb(worldBox);
+    const SceneObjects& objs = tree_->objects();
+    return QueryVolume::fromTransformedBox(objs.matrix(ref.object), objs.model(objs.modelOf(ref.object)).nodes[ref.node].box);
+}
+
+void QueryScheduler::drawNode(NodeRef ref) {
+    const SceneObjects& objs = tree_->objects();
+    const LocalBspNode& n = objs.model(objs.modelOf(ref.object)).nodes[ref.node];
+    const auto t0 = Clock::now();
+    sink_->drawPart(ref.object, n.firstIndex, n.indexCount);
+    stats_->drawMs += msSince(t0);
+    ++stats_->partsDrawn;
+    stats_->trianglesDrawn += n.indexCount / 3;
+    if (params_.mode == CullMode::Full && params_.useOccupancyAccept) {
+        ScreenRect r;
+        projectRect(tree_->worldBox(ref), r);
+        drawnMap_.mark(r);
+    }
+}
+
+void QueryScheduler::processVisible(NodeRef ref, NodeHistory& h) {
+    // Algorithm 4: draw a part, or replace the node by its children front-to-back.
+    h.lastVisible = true;
+    h.lastVisibleFrame = frame_;
+    if (tree_->isDrawable(ref)) {
+        drawNode(ref);
+        return;
+    }
+    scratch_.clear();
+    tree_->expand(ref, camera_.position, scratch_);
+    // active_ is a stack whose back is processed next: push the farthest first.
+    for (auto it = scratch_.rbegin(); it != scratch_.rend(); ++it) active_.push_back(*it);
+}
+
+void QueryScheduler::runVfc() {
+    while (!active_.empty()) {
+        const NodeRef ref = active_.back();
+        active_.pop_back();
+        ++stats_->nodesVisited;
+        if (frustum_.outside(tree_->worldBox(ref))) {
+            ++stats_->frustumCulled;
+            continue;
+        }
+        NodeHistory& h = history_.at(ref, tree_->objects());
+        h.lastTouchedFrame = frame_;
+        processVisible(ref, h);
+    }
+}
+
+void QueryScheduler::runSimple() {
+    // Simple OC: hierarchical, one stop-and-wait query per node in the frustum.
+    while (!active_.empty()) {
+        const NodeRef ref = active_.back();
+        active_.pop_back();
+        ++stats_->nodesVisited;
+        const Aabb box = tree_->worldBox(ref);
+        NodeHistory& h = history_.at(ref, tree_->objects());
+        const FirstTest ft = firstVisibilityTest(ref, box, h, *stats_);
+        h.lastTouchedFrame = frame_;
+        if (ft == FirstTest::Invisible) continue;
+        if (ft == FirstTest::NeedQuery) {
+            backend_->beginBatch();
+            const QueryId id = backend_->issue(QueryVolume::fromAabb(box));
+            backend_->endBatch();
+            ++stats_->queriesIssued;
+            ++stats_->batches;
+            const auto tw = Clock::now();
+            const QueryResult r = backend_->wait(id, params_.queryTimeoutMs);
+            stats_->waitMs += msSince(tw);
+            backend_->release(id);
+            if (r == QueryResult::NotReady) ++stats_->queriesTimedOut;
+            const bool visible = r != QueryResult::Occluded;
+            history_.recordAnswer(h, visible, frame_);
+            if (!visible) {
+                ++stats_->queriesOccluded;
+                continue;
+            }
+        }
+        processVisible(ref, h);
+    }
+}
+
+void QueryScheduler::finishQuery(Pending& p, QueryResult r) {
+    backend_->release(p.id);
+    if (p.batchedRect) pendingMap_.unmark(p.rect);
+    if (r == QueryResult::NotReady) ++stats_->queriesTimedOut;  // from wait(): timed out
+    const bool visible = r != QueryResult::Occluded;
+    NodeHistory& h = history_.at(p.node, tree_->objects());
+    history_.recordAnswer(h, visible, frame_);
+    if (visible)
+        processVisible(p.node, h);
+    else
+        ++stats_->queriesOccluded;
+}
+
+void QueryScheduler::runFull() {
+    // Algorithm 2 with batching: the active list (a stack, nearest at the back) is refined
+    // as visible nodes are replaced by their children; nodes that need a query but overlap
+    // a pending query's rectangle (or exceed the in-flight limit) wait in `deferred`.
+    const SceneObjects& objs = tree_->objects();
+    bool batchOpen = false;
+    auto openBatch = [&] {
+        if (!batchOpen) {
+            backend_->beginBatch();
+            batchOpen = true;
+            ++stats_->batches;
+        }
+    };
+    auto closeBatch = [&] {
+        if (batchOpen) {
+            backend_->endBatch();
+            batchOpen = false;
+        }
+    };
+    // Issue a query for `ref` now if allowed; false if it must wait.
+    auto tryIssue = [&](NodeRef ref, const Aabb& box, const ScreenRect& rect) -> bool {
+        if (pending_.size() >= params_.maxQueriesInFlight) return false;
+        if (params_.useBatching) {
+            if (pendingMap_.anySet(rect)) return false;
+        } else if (!pending_.empty()) {
+            return false;  // no batching: one query in flight at a time
+        }
+        if (!ref.isSceneNode()) {
+            const glm::mat4& m = objs.matrix(ref.object);
+            if (m != lastMatrix_[ref.object]) {
+                lastMatrix_[ref.object] = m;
+                stillSince_[ref.object] = frame_;
+            }
+        }
+        openBatch();
+        const QueryId id = backend_->issue(queryVolume(ref, box));
+        ++stats_->queriesIssued;
+        const bool marked = params_.useBatching;
+        if (marked) pendingMap_.mark(rect);
+        pending_.push_back({ref, id, rect, marked});
+        return true;
+    };
+
+    struct Deferred {
+        NodeRef ref;
+        Aabb box;
+        ScreenRect rect;
+    };
+    std::vector<Deferred> deferred;
+
+    while (!active_.empty() || !deferred.empty() || !pending_.empty()) {
+        bool progress = false;
+
+        // 1. Finish answered queries, oldest first; visible ones push their children.
+        closeBatch();
+        for (std::size_t i = 0; i < pending_.size();) {
+            const QueryResult r = backend_->poll(pending_[i].id);
+            if (r == QueryResult::NotReady) {
+                ++i;
+                continue;
+            }
+            Pending p = pending_[i];
+            pending_.erase(pending_.begin() + static_cast<std::ptrdiff_t>(i));
+            finishQuery(p, r);
+            progress = true;
+        }
+
+        // 2. Process the active list front-to-back.
+        while (!active_.empty()) {
+            const NodeRef ref = active_.back();
+            active_.pop_back();
+            ++stats_->nodesVisited;
+            progress = true;
+            const Aabb box = tree_->worldBox(ref);
+            NodeHistory& h = history_.at(ref, objs);
+            const FirstTest ft = firstVisibilityTest(ref, box, h, *stats_);  // reads last frame's lastTouchedFrame
+            h.lastTouchedFrame = frame_;
+            if (ft == FirstTest::Invisible) continue;
+            if (ft == FirstTest::Visible) {
+                closeBatch();
+                processVisible(ref, h);
+                continue;
+            }
+            ScreenRect rect;
+            projectRect(box, rect);
+            if (params_.useOccupancyAccept && !drawnMap_.allSet(rect)) {
+                // Touches screen area where nothing has been drawn: nothing can hide it.
+                ++stats_->skippedByOccupancy;
+                history_.recordAnswer(h, true, frame_);
+                closeBatch();
+                processVisible(ref, h);
+                continue;
+            }
+            if (!tryIssue(ref, box, rect)) deferred.push_back({ref, box, rect});
+        }
+
+        // 3. Retry deferred nodes in order (the drawn map only fills up, so the occupancy
+        // accept cannot newly succeed; only the pending rectangles and the limit matter).
+        for (std::size_t i = 0; i < deferred.size() && pending_.size() < params_.maxQueriesInFlight;) {
+            if (tryIssue(deferred[i].ref, deferred[i].box, deferred[i].rect)) {
+                deferred.erase(deferred.begin() + static_cast<std::ptrdiff_t>(i));
+                progress = true;
+            } else {
+                ++i;
+            }
+        }
+        closeBatch();
+
+        // 4. Nothing else to do: wait for the oldest query.
+        if (!progress && active_.empty() && !pending_.empty()) {
+            const auto tw = Clock::now();
+            const QueryResult r = backend_->wait(pending_.front().id, params_.queryTimeoutMs);
+            stats_->waitMs += msSince(tw);
+            Pending p = pending_.front();
+            pending_.erase(pending_.begin());
+            finishQuery(p, r);
+        }
+    }
+    closeBatch();
+}
+
+}  // namespace dyncull

@@ -1,0 +1,70 @@
+// Visibility history. Paper: Two-level BSP for dynamic occlusion culling, section 3.4,
+// Algorithm 3 (ExamineRecentQueryResults) and Figure 3.
+#include "dyncull/scheduler/visibility_history.hpp"
+
+#include <algorithm>
+#include <bit>
+
+namespace dyncull {
+
+NodeHistory& VisibilityHistory::at(NodeRef ref, const SceneObjects& objects) {
+    if (ref.isSceneNode()) {
+        if (ref.node >= scene_.size()) scene_.resize(ref.node + 1);
+        return scene_[ref.node];
+    }
+    const std::uint32_t slot = ref.object;
+    if (slot >= objectBase_.size()) {
+        objectBase_.resize(slot + 1, kInvalidIndex);
+        objectGen_.resize(slot + 1, 0);
+        objectModel_.resize(slot + 1, kInvalidIndex);
+    }
+    const std::uint32_t gen = objects.handle(slot).generation;
+    const ModelId model = objects.modelOf(slot);
+    const std::size_t nodes = objects.model(model).nodes.size();
+    if (objectBase_[slot] == kInvalidIndex || objectModel_[slot] != model) {
+        // New block; a slot whose model changed leaks its old block until clear(), which
+        // only happens when objects are re-created with another model (rare).
+        objectBase_[slot] = static_cast<std::uint32_t>(objectNodes_.size());
+        objectNodes_.resize(objectNodes_.size() + nodes);
+        objectModel_[slot] = model;
+        objectGen_[slot] = gen;
+    } else if (objectGen_[slot] != gen) {
+        // Slot reused by a new object of the same model: its history means nothing now.
+        std::fill_n(objectNodes_.begin() + objectBase_[slot], nodes, NodeHistory{});
+        objectGen_[slot] = gen;
+    }
+    return objectNodes_[objectBase_[slot] + ref.node];
+}
+
+void VisibilityHistory::clear() {
+    scene_.clear();
+    objectNodes_.clear();
+    objectBase_.clear();
+    objectGen_.clear();
+    objectModel_.clear();
+}
+
+void VisibilityHistory::recordAnswer(NodeHistory& h, bool visible, std::uint32_t frame) const {
+    h.bits = static_cast<std::uint8_t>((h.bits << 1) | (visible ? 1u : 0u));
+    h.answers = static_cast<std::uint8_t>(std::min<int>(h.answers + 1, 8));
+    h.lastQueryFrame = frame;
+    h.lastVisible = visible;
+    if (visible) h.lastVisibleFrame = frame;
+}
+
+bool VisibilityHistory::canSkipQuery(const NodeHistory& h, std::uint32_t frame, const HistoryParams& p) const {
+    // Only a node reached and visible in the previous frame may skip ("invisible last
+    // time -> query"); a node not reached last frame (parent culled) was not visible.
+    if (!h.lastVisible || h.lastTouchedFrame + 1 != frame) return false;
+    const std::uint32_t visibleAnswers = static_cast<std::uint32_t>(std::popcount(h.bits));
+    if (visibleAnswers < p.minVisibleToSkip) return false;
+    const std::uint32_t skip = std::min(p.maxSkipFrames, p.skipFramesPerVisible * visibleAnswers);
+    return frame - h.lastQueryFrame <= skip;
+}
+
+std::size_t VisibilityHistory::memoryBytes() const {
+    return (scene_.capacity() + objectNodes_.capacity()) * sizeof(NodeHistory) +
+           (objectBase_.capacity() + objectGen_.capacity() + objectModel_.capacity()) * sizeof(std::uint32_t);
+}
+
+}  // namespace dyncull
