@@ -23,7 +23,7 @@ namespace dyncull {
 using MeshId = std::uint32_t;
 
 /// Counters of the current (or last) frame; reset by beginFrame.
-struct FrameStats {
+struct RenderStats {
     std::uint64_t drawCalls = 0;
     std::uint64_t triangles = 0;
     std::uint64_t boxes = 0;  ///< drawBoxDepthTestOnly calls
@@ -70,7 +70,7 @@ public:
     /// Reads the context framebuffer as a top-down RGBA8 image (waits for the GPU).
     Image readPixels() const;
 
-    const FrameStats& stats() const { return stats_; }
+    const RenderStats& stats() const { return stats_; }
     const glm::mat4& viewProjection() const { return viewProj_; }
     GlContext& context() { return context_; }
 
@@ -90,7 +90,7 @@ private:
     std::uint32_t program_ = 0;
     int locViewProj_ = -1, locModel_ = -1, locNormalMat_ = -1, locColour_ = -1, locEye_ = -1, locLight_ = -1;
     glm::mat4 viewProj_{1.0f};
-    FrameStats stats_;
+    RenderStats stats_;
     std::unique_ptr<BoxDrawer> boxes_;
 };
 

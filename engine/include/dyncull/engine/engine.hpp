@@ -1,0 +1,98 @@
+// The API a game calls each frame: add models and objects, update transforms, set the
+// camera, then cull and draw. Owns the whole pipeline of one scene:
+//   transforms -> loose-BSP relink -> front-to-back traversal -> query scheduler ->
+//   query backend -> draw (dyncull's renderer, or the game's callback).
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "dyncull/bsp/local_bsp.hpp"
+#include "dyncull/bsp/loose_bsp.hpp"
+#include "dyncull/bsp/scene_objects.hpp"
+#include "dyncull/engine/gl_context.hpp"
+#include "dyncull/engine/gl_query_backend.hpp"
+#include "dyncull/engine/renderer.hpp"
+#include "dyncull/objects/camera.hpp"
+#include "dyncull/objects/error.hpp"
+#include "dyncull/scheduler/query_scheduler.hpp"
+
+namespace dyncull {
+
+struct EngineOptions {
+    LooseBspParams sceneTree;
+    SchedulerParams scheduler;
+    GlQueryParams queries;
+};
+
+/// Draws one object part with the game's own renderer: `object` is the handle given by
+/// addObject, the range indexes the model's split mesh (Engine::model(id).mesh), and
+/// `objectToWorld` is the object's current matrix. Called between beginFrame/endFrame
+/// with dyncull's GL state otherwise untouched.
+using DrawPartCallback =
+    std::function<void(ObjectHandle object, ModelId model, std::uint32_t firstIndex, std::uint32_t indexCount,
+                       const glm::mat4& objectToWorld)>;
+
+/// Borrows the GL context (which must outlive the Engine and be current on calls).
+class Engine {
+public:
+    static Expected<std::unique_ptr<Engine>> create(GlContext& context, const EngineOptions& options = {});
+
+    /// Builds the model's local BSP (object space) and uploads its split mesh once.
+    Expected<ModelId> addModel(const Mesh& mesh, const LocalBspParams& params = {});
+    /// Adds a prebuilt local BSP (e.g. loaded from a cache).
+    ModelId addModel(LocalBsp bsp);
+    Expected<ObjectHandle> addObject(ModelId model, const Transform& transform, bool isStatic = false);
+    Status removeObject(ObjectHandle object);
+    /// Rejects NaN/Inf, zero scale and non-unit rotations with an error; the object keeps its old transform.
+    Status setTransform(ObjectHandle object, const Transform& transform);
+    /// Rejects invalid cameras (validateCamera); the aspect should match the framebuffer.
+    Status setCamera(const Camera& camera);
+    Status setSchedulerParams(const SchedulerParams& params);
+    void setQueryParams(const GlQueryParams& params) { backend_->setParams(params); }
+    /// Replaces dyncull's renderer for parts (nullptr restores it).
+    void setDrawCallback(DrawPartCallback callback) { callback_ = std::move(callback); }
+    /// Per-object colour for dyncull's renderer (default: colourForId of the slot).
+    void setColour(ObjectHandle object, const glm::vec3& colour);
+
+    /// One frame: relink moved objects, cull, draw, and glFinish (so frameMs bounds the
+    /// GPU work too). Does not present; windowed callers call context().present().
+    FrameStats renderFrame() { return renderFrame(scheduler_); }
+    /// The same with another scheduler (its own mode, parameters and visibility history),
+    /// so several configurations can be run interleaved over the same frames of one scene.
+    FrameStats renderFrame(QueryScheduler& scheduler);
+    /// Relinks moved objects now (renderFrame does it too; calling twice costs nothing).
+    LooseBspFrameStats updateSceneTree();
+    /// When false, renderFrame skips the final glFinish (frameMs then excludes GPU time).
+    void setFinishEachFrame(bool finish) { finishEachFrame_ = finish; }
+
+    const SceneObjects& objects() const { return objects_; }
+    const LooseBsp& sceneTree() const { return tree_; }
+    const LocalBsp& model(ModelId id) const { return objects_.model(id); }
+    const Camera& camera() const { return camera_; }
+    Renderer& renderer() { return *renderer_; }
+    GlContext& context() { return context_; }
+    QueryScheduler& scheduler() { return scheduler_; }
+    GlQueryBackend& queryBackend() { return *backend_; }
+
+private:
+    Engine(GlContext& context, const EngineOptions& options);
+    struct Sink;
+
+    GlContext& context_;
+    std::unique_ptr<Renderer> renderer_;
+    std::unique_ptr<GlQueryBackend> backend_;
+    SceneObjects objects_;
+    LooseBsp tree_;
+    bool treeBuilt_ = false;
+    QueryScheduler scheduler_;
+    Camera camera_;
+    std::vector<MeshId> meshOfModel_;
+    std::vector<glm::vec3> colour_;  // per object slot
+    std::vector<std::uint8_t> hasColour_;
+    DrawPartCallback callback_;
+    bool finishEachFrame_ = true;
+};
+
+}  // namespace dyncull

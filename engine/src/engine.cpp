@@ -1,0 +1,116 @@
+#include "dyncull/engine/engine.hpp"
+
+#include <chrono>
+
+#include <epoxy/gl.h>
+
+namespace dyncull {
+
+struct Engine::Sink final : PartSink {
+    Engine& e;
+    explicit Sink(Engine& engine) : e(engine) {}
+    void drawPart(std::uint32_t object, std::uint32_t firstIndex, std::uint32_t indexCount) override {
+        const SceneObjects& objs = e.objects_;
+        const ModelId model = objs.modelOf(object);
+        if (e.callback_) {
+            e.callback_(objs.handle(object), model, firstIndex, indexCount, objs.matrix(object));
+            return;
+        }
+        const glm::vec3 colour = object < e.hasColour_.size() && e.hasColour_[object] ? e.colour_[object] : colourForId(object);
+        e.renderer_->drawRange(e.meshOfModel_[model], firstIndex, indexCount, objs.matrix(object), colour);
+    }
+};
+
+Engine::Engine(GlContext& context, const EngineOptions& options)
+    : context_(context), tree_(options.sceneTree), scheduler_(options.scheduler) {}
+
+Expected<std::unique_ptr<Engine>> Engine::create(GlContext& context, const EngineOptions& options) {
+    if (Status s = validateSchedulerParams(options.scheduler); !s) return Error{s.message()};
+    std::unique_ptr<Engine> e(new Engine(context, options));
+    auto renderer = Renderer::create(context);
+    if (!renderer) return renderer.error();
+    e->renderer_ = renderer.take();
+    auto backend = GlQueryBackend::create(context, options.queries);
+    if (!backend) return backend.error();
+    e->backend_ = backend.take();
+    const glm::ivec2 size = context.size();
+    e->camera_.aspect = static_cast<float>(size.x) / static_cast<float>(size.y);
+    return e;
+}
+
+Expected<ModelId> Engine::addModel(const Mesh& mesh, const LocalBspParams& params) {
+    auto bsp = buildLocalBsp(mesh, params);
+    if (!bsp) return bsp.error();
+    return addModel(bsp.take());
+}
+
+ModelId Engine::addModel(LocalBsp bsp) {
+    const MeshId mesh = renderer_->upload(bsp.mesh);
+    const ModelId id = objects_.addModel(std::move(bsp));
+    if (meshOfModel_.size() <= id) meshOfModel_.resize(id + 1);
+    meshOfModel_[id] = mesh;
+    return id;
+}
+
+Expected<ObjectHandle> Engine::addObject(ModelId model, const Transform& transform, bool isStatic) {
+    return objects_.addObject(model, transform, isStatic);
+}
+
+Status Engine::removeObject(ObjectHandle object) { return objects_.removeObject(object); }
+
+Status Engine::setTransform(ObjectHandle object, const Transform& transform) {
+    return objects_.setTransform(object, transform);
+}
+
+Status Engine::setCamera(const Camera& camera) {
+    if (Status s = validateCamera(camera); !s) return s;
+    camera_ = camera;
+    return {};
+}
+
+Status Engine::setSchedulerParams(const SchedulerParams& params) {
+    if (Status s = validateSchedulerParams(params); !s) return s;
+    scheduler_.setParams(params);
+    return {};
+}
+
+void Engine::setColour(ObjectHandle object, const glm::vec3& colour) {
+    if (!objects_.alive(object)) return;
+    if (colour_.size() <= object.index) {
+        colour_.resize(object.index + 1);
+        hasColour_.resize(object.index + 1, 0);
+    }
+    colour_[object.index] = colour;
+    hasColour_[object.index] = 1;
+}
+
+LooseBspFrameStats Engine::updateSceneTree() {
+    if (!treeBuilt_) {
+        const auto t0 = std::chrono::steady_clock::now();
+        tree_.build(objects_);
+        treeBuilt_ = true;
+        LooseBspFrameStats st;
+        st.updateMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        return st;
+    }
+    return tree_.update(objects_);
+}
+
+FrameStats Engine::renderFrame(QueryScheduler& scheduler) {
+    using Clock = std::chrono::steady_clock;
+    const auto t0 = Clock::now();
+    const double updateMs = updateSceneTree().updateMs;
+
+    renderer_->beginFrame(camera_);
+    Sink sink(*this);
+    TwoLevelTree tree(tree_, objects_);
+    const glm::ivec2 size = context_.size();
+    FrameStats st = scheduler.cullFrame(tree, camera_, size.x, size.y, *backend_, sink);
+    renderer_->endFrame();
+    if (finishEachFrame_) glFinish();
+    st.updateMs = updateMs;
+    st.frameMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    return st;
+}
+
+}  // namespace dyncull
