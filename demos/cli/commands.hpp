@@ -8,5 +8,6 @@
 namespace dyncull::cli {
 
 void registerView(CLI::App& app);
+void registerRun(CLI::App& app);
 
 }  // namespace dyncull::cli

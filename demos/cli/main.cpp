@@ -7,6 +7,7 @@ int main(int argc, char** argv) {
     CLI::App app{"dyncull: occlusion culling for dynamic scenes (two-level BSP + occlusion queries)"};
     app.require_subcommand(1);
     dyncull::cli::registerView(app);
+    dyncull::cli::registerRun(app);
     CLI11_PARSE(app, argc, argv);
     return 0;
 }

@@ -1,0 +1,134 @@
+// `dyncull run SCENE`: play a scene's camera path with one culling mode, headless (EGL,
+// the default) or in a window, writing per-frame stats (CSV) and screenshots.
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+
+#include "cli_util.hpp"
+#include "commands.hpp"
+#include "dyncull/demos/demo_scene.hpp"
+#include "dyncull/engine/engine.hpp"
+#include "dyncull/engine/image.hpp"
+#include "scene_options.hpp"
+
+namespace dyncull::cli {
+namespace {
+
+struct RunOptions {
+    std::string scene = "bunnies";
+    std::string mode = "full";
+    std::uint64_t frames = 0;  // 0: the scene's default path length
+    std::string size = "1280x720";
+    std::string out;  // default out/<scene>
+    std::string stats;
+    std::string screenshot;
+    std::vector<std::uint64_t> shots;
+    bool window = false;
+    BunnySwarmOptions bunny;
+    SchedulerFlags flags;
+};
+
+void writeCsvHeader(std::ofstream& f) {
+    f << "frame,ms_frame,ms_traversal,ms_wait,ms_draw,ms_update,queries,queries_occluded,skipped_history,"
+         "skipped_occupancy,visible_near,frustum_culled,nodes_visited,batches,parts,triangles\n";
+}
+
+void writeCsvRow(std::ofstream& f, std::uint64_t frame, const FrameStats& s) {
+    f << frame << ',' << s.frameMs << ',' << s.traversalMs << ',' << s.waitMs << ',' << s.drawMs << ',' << s.updateMs
+      << ',' << s.queriesIssued << ',' << s.queriesOccluded << ',' << s.skippedByHistory << ',' << s.skippedByOccupancy
+      << ',' << s.visibleNearOrInside << ',' << s.frustumCulled << ',' << s.nodesVisited << ',' << s.batches << ','
+      << s.partsDrawn << ',' << s.trianglesDrawn << '\n';
+}
+
+void runRun(RunOptions o) {
+    auto size = parseSize(o.size, "--size");
+    if (!size) fail(size.error().message);
+    auto mode = parseCullMode(o.mode);
+    if (!mode) fail("--mode: " + mode.error().message);
+    auto made = makeScene(o.scene, o.bunny);
+    if (!made) fail(made.error().message);
+    DemoScene& scene = **made;
+    if (o.out.empty()) o.out = "out/" + scene.name();
+    if (o.stats.empty()) o.stats = o.out + "/frames_" + o.mode + ".csv";
+    if (o.screenshot.empty()) o.screenshot = o.out + "/last_" + o.mode + ".png";
+
+    ContextOptions co;
+    co.kind = o.window ? ContextKind::GlfwWindow : ContextKind::HeadlessEgl;
+    co.width = size->x;
+    co.height = size->y;
+    co.title = "dyncull run " + o.scene;
+    auto context = GlContext::create(co);
+    if (!context) fail(context.error().message);
+    GlContext& ctx = **context;
+
+    EngineOptions eo;
+    eo.scheduler = toParams(o.flags, *mode);
+    eo.queries.visiblePixelThreshold = o.flags.pixelThreshold;
+    auto engineOr = Engine::create(ctx, eo);
+    if (!engineOr) fail(engineOr.error().message);
+    Engine& engine = **engineOr;
+    if (Status s = scene.populate(engine); !s) fail(s.message());
+    std::printf("%s\n", scene.description().c_str());
+    std::printf("context: %s, %s; set-up %.0f ms\n", ctx.platformName().c_str(), ctx.rendererName().c_str(), scene.setupMs());
+
+    const std::uint64_t frames = o.frames ? o.frames : scene.defaultFrames();
+    if (Status s = ensureParentDirectory(o.stats); !s) fail(s.message());
+    std::ofstream csv(o.stats);
+    if (!csv) fail(o.stats + ": cannot write");
+    writeCsvHeader(csv);
+
+    double ms = 0, queries = 0, parts = 0, triangles = 0;
+    std::vector<std::string> written;
+    const float aspect = static_cast<float>(size->x) / static_cast<float>(size->y);
+    std::uint64_t frame = 0;
+    for (; frame < frames && !ctx.shouldClose(); ++frame) {
+        if (Status s = scene.update(engine, frame); !s) fail(s.message());
+        if (Status s = engine.setCamera(scene.camera(frame, aspect)); !s) fail(s.message());
+        const FrameStats st = engine.renderFrame();
+        writeCsvRow(csv, frame, st);
+        ms += st.frameMs;
+        queries += st.queriesIssued;
+        parts += st.partsDrawn;
+        triangles += static_cast<double>(st.trianglesDrawn);
+        const bool last = frame + 1 == frames;
+        if (last || std::find(o.shots.begin(), o.shots.end(), frame) != o.shots.end()) {
+            const std::string path = last ? o.screenshot : o.out + "/frame" + std::to_string(frame) + "_" + o.mode + ".png";
+            if (Status s = ensureParentDirectory(path); !s) fail(s.message());
+            if (Status s = writePng(engine.renderer().readPixels(), path); !s) fail(s.message());
+            written.push_back(path);
+        }
+        if (o.window) ctx.present();
+    }
+    const double n = static_cast<double>(std::max<std::uint64_t>(frame, 1));
+    if (ctx.checkErrors() != 0)
+        std::fprintf(stderr, "warning: %llu GL errors\n", static_cast<unsigned long long>(ctx.glErrorCount()));
+    std::printf("stats: %s\n", o.stats.c_str());
+    for (const std::string& p : written) std::printf("picture: %s\n", p.c_str());
+    std::printf("summary scene=%s mode=%s frames=%llu ms_per_frame=%.2f queries_per_frame=%.1f parts_per_frame=%.1f "
+                "triangles_per_frame=%.0f\n",
+                scene.name().c_str(), o.mode.c_str(), static_cast<unsigned long long>(frame), ms / n, queries / n,
+                parts / n, triangles / n);
+}
+
+}  // namespace
+
+void registerRun(CLI::App& app) {
+    auto o = std::make_shared<RunOptions>();
+    CLI::App* cmd = app.add_subcommand("run", "Play a scene's camera path with one culling mode (headless by default)");
+    cmd->add_option("scene", o->scene, "bunnies, or a .ply/.obj/.gltf/.glb file")->capture_default_str();
+    cmd->add_option("--mode", o->mode, "vfc, simple or full")->capture_default_str();
+    cmd->add_option("--frames", o->frames, "frames to run (default: the scene's camera path once)");
+    cmd->add_option("--size", o->size, "framebuffer size WxH")->capture_default_str();
+    cmd->add_option("--out", o->out, "output directory (default out/<scene>)");
+    cmd->add_option("--stats", o->stats, "per-frame CSV (default <out>/frames_<mode>.csv)");
+    cmd->add_option("--screenshot", o->screenshot, "PNG of the last frame (default <out>/last_<mode>.png)");
+    cmd->add_option("--shots", o->shots, "also write PNGs of these frames")->delimiter(',');
+    cmd->add_flag("--window", o->window, "show a GLFW window instead of rendering headless");
+    addBunnyOptions(*cmd, o->bunny);
+    addSchedulerOptions(*cmd, o->flags);
+    cmd->callback([o] { runRun(*o); });
+}
+
+}  // namespace dyncull::cli

@@ -1,0 +1,25 @@
+// Options shared by subcommands that run a scene (run, bench, sweep): the bunny-swarm
+// parameters and the scheduler's switches, registered on a CLI11 subcommand.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include "dyncull/demos/demo_scene.hpp"
+#include "dyncull/scheduler/query_scheduler.hpp"
+
+namespace dyncull::cli {
+
+/// Adds --count --box --bunny-size --speed --seed --orbit --mesh --assets --path-frames.
+void addBunnyOptions(CLI::App& cmd, BunnySwarmOptions& o);
+
+/// Scheduler switches for `full` ablations and tuning.
+struct SchedulerFlags {
+    bool noHistory = false, noBatching = false, noOccupancy = false, noTight = false;
+    std::uint32_t maxInFlight = SchedulerParams{}.maxQueriesInFlight;
+    std::uint32_t maxSkip = SchedulerParams{}.history.maxSkipFrames;
+    std::uint32_t pixelThreshold = 0;
+};
+void addSchedulerOptions(CLI::App& cmd, SchedulerFlags& f);
+SchedulerParams toParams(const SchedulerFlags& f, CullMode mode);
+
+}  // namespace dyncull::cli

@@ -1,0 +1,74 @@
+// Built-in demo scenes and file scenes behind one interface, so `dyncull run`, `bench`,
+// the tests and the benchmarks drive every scene the same way: populate an Engine once,
+// then per frame move the objects and place the camera (both pure functions of the
+// frame index, so every run and every mode sees the same frames).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "dyncull/engine/engine.hpp"
+#include "dyncull/objects/camera.hpp"
+#include "dyncull/objects/error.hpp"
+
+namespace dyncull {
+
+class DemoScene {
+public:
+    virtual ~DemoScene() = default;
+    /// Short name used in stats and file names ("bunnies", "sponza_dabrovic", ...).
+    virtual std::string name() const = 0;
+    /// One or more lines saying what was loaded or generated (mesh used, counts).
+    virtual std::string description() const = 0;
+    /// Adds models and objects to `engine` (call once, on an empty engine).
+    virtual Status populate(Engine& engine) = 0;
+    /// Moves dynamic objects to their positions at `frame` (no-op for static scenes).
+    virtual Status update(Engine& engine, std::uint64_t frame) = 0;
+    /// Camera at `frame` for a viewport of aspect `aspect` (width / height).
+    virtual Camera camera(std::uint64_t frame, float aspect) const = 0;
+    /// Frames of the default camera path.
+    virtual std::uint64_t defaultFrames() const = 0;
+    /// Set-up time (loading, subdivision, local BSP builds), ms, filled by populate.
+    double setupMs() const { return setupMs_; }
+
+protected:
+    double setupMs_ = 0.0;
+};
+
+/// Options of the bunny swarm; every one is a CLI option of `dyncull run bunnies`.
+struct BunnySwarmOptions {
+    std::uint32_t count = 300;
+    float box = 12.0f;        ///< side of the cubic box the bunnies move in, world units
+    float bunnySize = 1.6f;   ///< longest side of one bunny's bounding box, world units
+    float speed = 0.03f;      ///< world units per frame
+    std::uint64_t seed = 1;
+    float orbit = 0.0f;       ///< > 0: orbit the box at this distance from its centre instead of the flight
+    std::string meshPath;     ///< explicit mesh file; empty: search the asset directory
+    std::string assetsDir;    ///< empty: $DYNCULL_ASSETS, else ./assets
+    std::uint32_t frames = 400;  ///< frames of one pass along the default path
+};
+
+/// Where the bunny mesh comes from, in order: `meshPath`; `<assets>/bun_zipper.ply` (the
+/// Stanford bunny, 69,451 triangles); `<assets>/bunny_npm.ply` (npm `bunny`, 3,674
+/// triangles, public domain) refined by two levels of Loop subdivision (58,784).
+struct BunnyMeshChoice {
+    std::string path;
+    bool subdivided = false;
+};
+Expected<BunnyMeshChoice> findBunnyMesh(const BunnySwarmOptions& options);
+
+std::unique_ptr<DemoScene> makeBunnySwarm(const BunnySwarmOptions& options);
+
+/// Any PLY/OBJ/glTF file as a static scene, with an automatic camera path: an orbit
+/// outside for compact models, a walkthrough along the long axis for interiors.
+std::unique_ptr<DemoScene> makeFileScene(const std::string& path);
+
+/// Resolves a scene argument: "bunnies" (with `bunny` options) or a file path.
+Expected<std::unique_ptr<DemoScene>> makeScene(const std::string& nameOrPath, const BunnySwarmOptions& bunny);
+
+/// Names of the built-in scenes, for help texts.
+std::vector<std::string> builtinSceneNames();
+
+}  // namespace dyncull
