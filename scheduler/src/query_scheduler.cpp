@@ -27,6 +27,20 @@ const char* toString(CullMode m) {
     return "?";
 }
 
+const char* toString(NodeState s) {
+    switch (s) {
+        case NodeState::FrustumCulled: return "frustum_culled";
+        case NodeState::Occluded: return "occluded";
+        case NodeState::SmallFeature: return "small_feature";
+        case NodeState::VisibleQueried: return "visible_queried";
+        case NodeState::VisibleHistory: return "visible_history";
+        case NodeState::VisibleOccupancy: return "visible_occupancy";
+        case NodeState::VisibleNear: return "visible_near";
+        case NodeState::VisibleVfc: return "visible_vfc";
+    }
+    return "?";
+}
+
 Expected<CullMode> parseCullMode(const std::string& s) {
     if (s == "vfc") return CullMode::Vfc;
     if (s == "simple") return CullMode::Simple;
@@ -60,6 +74,7 @@ FrameStats QueryScheduler::cullFrame(const TwoLevelTree& tree, const Camera& cam
     stats_ = &st;
     active_.clear();
     pending_.clear();
+    if (trace_) trace_->clear();
     if (drawnMap_.tilesX() * params_.occupancyTileSize < width || drawnMap_.tilesY() * params_.occupancyTileSize < height ||
         (drawnMap_.tilesX() - 1) * params_.occupancyTileSize >= width) {
         drawnMap_.reset(width, height, params_.occupancyTileSize);
@@ -141,6 +156,7 @@ QueryScheduler::FirstTest QueryScheduler::firstVisibilityTest(NodeRef ref, const
     if (frustum_.outside(box)) {
         ++st.frustumCulled;
         h.lastVisible = false;
+        trace(ref, box, NodeState::FrustumCulled);
         return FirstTest::Invisible;
     }
     ScreenRect rect;
@@ -149,18 +165,26 @@ QueryScheduler::FirstTest QueryScheduler::firstVisibilityTest(NodeRef ref, const
         // Camera inside or box crossing the near plane: a query could be clipped away
         // and wrongly answer "occluded", so such a node is always visible.
         ++st.visibleNearOrInside;
+        trace(ref, box, NodeState::VisibleNear);
         return FirstTest::Visible;
     }
     if (rect.empty()) {
         // Passed the conservative plane test but projects to no pixel of the viewport.
         ++st.frustumCulled;
         h.lastVisible = false;
+        trace(ref, box, NodeState::FrustumCulled);
         return FirstTest::Invisible;
     }
-    (void)ref;
-    if (params_.mode == CullMode::Full && params_.useHistory &&
-        history_.canSkipQuery(h, frame_, params_.history)) {
+    if (params_.mode != CullMode::Full) return FirstTest::NeedQuery;
+    if (params_.smallFeaturePixels > 0 && static_cast<std::uint32_t>(rect.area()) < params_.smallFeaturePixels) {
+        ++st.smallFeatureCulled;
+        h.lastVisible = false;
+        trace(ref, box, NodeState::SmallFeature);
+        return FirstTest::Invisible;
+    }
+    if (params_.useHistory && history_.canSkipQuery(h, frame_, params_.history)) {
         ++st.skippedByHistory;
+        trace(ref, box, NodeState::VisibleHistory);
         return FirstTest::Visible;
     }
     return FirstTest::NeedQuery;
@@ -211,10 +235,12 @@ void QueryScheduler::runVfc() {
         ++stats_->nodesVisited;
         if (frustum_.outside(tree_->worldBox(ref))) {
             ++stats_->frustumCulled;
+            if (trace_) trace(ref, tree_->worldBox(ref), NodeState::FrustumCulled);
             continue;
         }
         NodeHistory& h = history_.at(ref, tree_->objects());
         h.lastTouchedFrame = frame_;
+        if (trace_) trace(ref, tree_->worldBox(ref), NodeState::VisibleVfc);
         processVisible(ref, h);
     }
 }
@@ -243,6 +269,7 @@ void QueryScheduler::runSimple() {
             if (r == QueryResult::NotReady) ++stats_->queriesTimedOut;
             const bool visible = r != QueryResult::Occluded;
             history_.recordAnswer(h, visible, frame_);
+            trace(ref, box, visible ? NodeState::VisibleQueried : NodeState::Occluded);
             if (!visible) {
                 ++stats_->queriesOccluded;
                 continue;
@@ -259,10 +286,33 @@ void QueryScheduler::finishQuery(Pending& p, QueryResult r) {
     const bool visible = r != QueryResult::Occluded;
     NodeHistory& h = history_.at(p.node, tree_->objects());
     history_.recordAnswer(h, visible, frame_);
+    if (trace_) trace(p.node, tree_->worldBox(p.node), visible ? NodeState::VisibleQueried : NodeState::Occluded);
     if (visible)
         processVisible(p.node, h);
     else
         ++stats_->queriesOccluded;
+}
+
+void QueryScheduler::collectLatent(bool block) {
+    // Answers to queries of earlier frames (useLastFrameResults): recorded in the history
+    // for the next decision; never drawn from here.
+    for (std::size_t i = 0; i < latent_.size();) {
+        Pending& p = latent_[i];
+        QueryResult r = backend_->poll(p.id);
+        if (r == QueryResult::NotReady && block) r = backend_->wait(p.id, params_.queryTimeoutMs);
+        if (r == QueryResult::NotReady) {
+            ++i;
+            continue;
+        }
+        backend_->release(p.id);
+        if (p.node.isSceneNode() || (p.node.object < tree_->objects().slotCount() && tree_->objects().alive(p.node.object))) {
+            NodeHistory& h = history_.at(p.node, tree_->objects());
+            h.queryInFlight = false;
+            history_.recordAnswer(h, r != QueryResult::Occluded, frame_);
+        }
+        latent_[i] = latent_.back();
+        latent_.pop_back();
+    }
 }
 
 void QueryScheduler::runFull() {
@@ -288,7 +338,7 @@ void QueryScheduler::runFull() {
     auto tryIssue = [&](NodeRef ref, const Aabb& box, const ScreenRect& rect) -> bool {
         if (pending_.size() >= params_.maxQueriesInFlight) return false;
         if (params_.useBatching) {
-            if (pendingMap_.anySet(rect)) return false;
+            if (!params_.batchOverlapping && pendingMap_.anySet(rect)) return false;
         } else if (!pending_.empty()) {
             return false;  // no batching: one query in flight at a time
         }
@@ -314,6 +364,7 @@ void QueryScheduler::runFull() {
         ScreenRect rect;
     };
     std::vector<Deferred> deferred;
+    collectLatent(false);
 
     while (!active_.empty() || !deferred.empty() || !pending_.empty()) {
         bool progress = false;
@@ -354,6 +405,26 @@ void QueryScheduler::runFull() {
                 // Touches screen area where nothing has been drawn: nothing can hide it.
                 ++stats_->skippedByOccupancy;
                 history_.recordAnswer(h, true, frame_);
+                trace(ref, box, NodeState::VisibleOccupancy);
+                closeBatch();
+                processVisible(ref, h);
+                continue;
+            }
+            if (params_.useLastFrameResults) {
+                // Approximate: act on the previous answer now, read this query next frame.
+                if (!h.queryInFlight) {
+                    openBatch();
+                    const QueryId id = backend_->issue(queryVolume(ref, box));
+                    ++stats_->queriesIssued;
+                    latent_.push_back({ref, id, rect, false});
+                    h.queryInFlight = true;
+                }
+                if (h.answers > 0 && !h.lastVisible) {
+                    ++stats_->queriesOccluded;
+                    trace(ref, box, NodeState::Occluded);
+                    continue;
+                }
+                trace(ref, box, NodeState::VisibleQueried);
                 closeBatch();
                 processVisible(ref, h);
                 continue;

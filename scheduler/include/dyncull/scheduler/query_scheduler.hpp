@@ -43,6 +43,38 @@ struct SchedulerParams {
     /// transformed local boxes instead of world AABBs (tightened boxes).
     std::uint32_t tightenAfterFrames = 3;
     double queryTimeoutMs = 250.0;  ///< a result that never arrives counts as visible
+
+    // Approximate settings (Full only). Each may drop visible pixels; `dyncull bench`
+    // measures how many. Defaults are conservative.
+    /// Cull nodes whose screen rectangle covers fewer than this many pixels (0 = off).
+    std::uint32_t smallFeaturePixels = 0;
+    /// Decide with the node's previous answer instead of waiting; the query issued now
+    /// is read next frame (one frame of latency, no waiting at all).
+    bool useLastFrameResults = false;
+    /// Issue queries even when their rectangles overlap pending ones (more answers
+    /// "visible" than needed; measured, conservative in itself).
+    bool batchOverlapping = false;
+};
+
+/// What the scheduler decided for a node reached during a frame (for the node-box view
+/// and for tests).
+enum class NodeState : std::uint8_t {
+    FrustumCulled,      ///< outside the frustum or off screen
+    Occluded,           ///< a query answered "occluded" (or last frame's answer, approximately)
+    SmallFeature,       ///< culled by the small-feature setting
+    VisibleQueried,     ///< a query answered "visible"
+    VisibleHistory,     ///< drawn without a query thanks to visibility history
+    VisibleOccupancy,   ///< drawn without a query: touched empty screen
+    VisibleNear,        ///< drawn without a query: camera inside or near plane crossed
+    VisibleVfc,         ///< vfc mode: in the frustum
+};
+const char* toString(NodeState s);
+
+/// One traced node: which, where (world AABB) and what was decided.
+struct NodeTrace {
+    NodeRef ref;
+    Aabb box;
+    NodeState state;
 };
 
 /// Validates ranges (e.g. tile size > 0, maxQueriesInFlight > 0).
@@ -65,6 +97,9 @@ public:
 
     /// Forget all history (e.g. after a camera cut).
     void resetHistory() { history_.clear(); }
+    /// When set, every decision of the following frames is appended to `*trace`
+    /// (cleared at the start of each frame). The caller owns the vector; nullptr stops.
+    void setTrace(std::vector<NodeTrace>* trace) { trace_ = trace; }
     std::uint32_t frameIndex() const { return frame_; }
 
 private:
@@ -106,6 +141,14 @@ private:
     std::vector<NodeRef> active_;   // stack: back() is the nearest unprocessed node
     std::vector<Pending> pending_;
     std::vector<NodeRef> scratch_;
+    std::vector<NodeTrace>* trace_ = nullptr;
+    // useLastFrameResults: queries issued in an earlier frame, read when they answer.
+    std::vector<Pending> latent_;
+
+    void trace(NodeRef ref, const Aabb& box, NodeState s) {
+        if (trace_) trace_->push_back({ref, box, s});
+    }
+    void collectLatent(bool block);
 };
 
 }  // namespace dyncull

@@ -27,6 +27,7 @@ struct NodeHistory {
     std::uint8_t bits = 0;
     std::uint8_t answers = 0;  ///< number of answers recorded, saturating at 8
     bool lastVisible = false;  ///< outcome the last time the node was reached (false: never seen)
+    bool queryInFlight = false;  ///< a query issued in an earlier frame has not been read yet
 };
 
 /// Storage for scene-tree and object-tree nodes together. Scene nodes by node index;
