@@ -9,5 +9,6 @@ namespace dyncull::cli {
 
 void registerView(CLI::App& app);
 void registerRun(CLI::App& app);
+void registerInspect(CLI::App& app);
 
 }  // namespace dyncull::cli

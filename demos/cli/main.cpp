@@ -8,6 +8,7 @@ int main(int argc, char** argv) {
     app.require_subcommand(1);
     dyncull::cli::registerView(app);
     dyncull::cli::registerRun(app);
+    dyncull::cli::registerInspect(app);
     CLI11_PARSE(app, argc, argv);
     return 0;
 }

@@ -182,7 +182,7 @@ QueryScheduler::FirstTest QueryScheduler::firstVisibilityTest(NodeRef ref, const
         trace(ref, box, NodeState::SmallFeature);
         return FirstTest::Invisible;
     }
-    if (params_.useHistory && history_.canSkipQuery(h, frame_, params_.history)) {
+    if (params_.useHistory && history_.canSkipQuery(ref, h, frame_, params_.history)) {
         ++st.skippedByHistory;
         trace(ref, box, NodeState::VisibleHistory);
         return FirstTest::Visible;

@@ -52,13 +52,17 @@ void VisibilityHistory::recordAnswer(NodeHistory& h, bool visible, std::uint32_t
     if (visible) h.lastVisibleFrame = frame;
 }
 
-bool VisibilityHistory::canSkipQuery(const NodeHistory& h, std::uint32_t frame, const HistoryParams& p) const {
+bool VisibilityHistory::canSkipQuery(NodeRef ref, const NodeHistory& h, std::uint32_t frame, const HistoryParams& p) const {
     // Only a node reached and visible in the previous frame may skip ("invisible last
     // time -> query"); a node not reached last frame (parent culled) was not visible.
     if (!h.lastVisible || h.lastTouchedFrame + 1 != frame) return false;
     const std::uint32_t visibleAnswers = static_cast<std::uint32_t>(std::popcount(h.bits));
     if (visibleAnswers < p.minVisibleToSkip) return false;
-    const std::uint32_t skip = std::min(p.maxSkipFrames, p.skipFramesPerVisible * visibleAnswers);
+    std::uint32_t skip = std::min(p.maxSkipFrames, p.skipFramesPerVisible * visibleAnswers);
+    if (p.jitter && skip >= 2) {
+        const std::uint32_t hash = (ref.object * 2654435761u) ^ (ref.node * 2246822519u) ^ 0x9e3779b9u;
+        skip -= (hash >> 7) % (skip / 2 + 1);
+    }
     return frame - h.lastQueryFrame <= skip;
 }
 

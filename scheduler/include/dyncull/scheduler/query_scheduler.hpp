@@ -40,8 +40,10 @@ struct SchedulerParams {
     std::uint32_t maxQueriesInFlight = 64;
     int occupancyTileSize = 16;  ///< pixels per tile side of both occupancy maps
     /// Objects that kept their transform this many frames are queried with their exact
-    /// transformed local boxes instead of world AABBs (tightened boxes).
-    std::uint32_t tightenAfterFrames = 3;
+    /// transformed local boxes instead of world AABBs (tightened boxes). The paper waits
+    /// because shrinking its boxes was costly; transforming 8 corners is not, so the
+    /// default tightens at once, moving objects included.
+    std::uint32_t tightenAfterFrames = 0;
     double queryTimeoutMs = 250.0;  ///< a result that never arrives counts as visible
 
     // Approximate settings (Full only). Each may drop visible pixels; `dyncull bench`

@@ -17,6 +17,8 @@ struct HistoryParams {
     std::uint32_t maxSkipFrames = 8;  ///< cap on the postponement
     /// Answers needed before any skipping starts (1 = skip after one visible answer).
     std::uint32_t minVisibleToSkip = 2;
+    /// Spread re-queries over frames with a fixed per-node shortening of the postponement.
+    bool jitter = true;
 };
 
 /// One node's record. `bits` holds the last 8 answers (bit 0 newest, 1 = visible).
@@ -43,7 +45,10 @@ public:
     /// True if the node may be drawn this frame without a query (Algorithm 3,
     /// ExamineRecentQueryResults): it was visible last time and the postponement that its
     /// count of visible answers earns has not run out.
-    bool canSkipQuery(const NodeHistory& h, std::uint32_t frame, const HistoryParams& p) const;
+    /// The postponement is shortened by a fixed per-node amount (up to half of it, from a
+    /// hash of `ref`) so nodes that became visible together do not all re-query in the
+    /// same later frame (which would make every k-th frame a spike of queries).
+    bool canSkipQuery(NodeRef ref, const NodeHistory& h, std::uint32_t frame, const HistoryParams& p) const;
 
     std::size_t memoryBytes() const;
 

@@ -1,0 +1,74 @@
+// `dyncull inspect FILE`: builds the local BSP of every mesh in a file and prints, per
+// mesh, triangles before and after splitting, leaves, depth and build time.
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "cli_util.hpp"
+#include "commands.hpp"
+#include "dyncull/bsp/local_bsp.hpp"
+#include "dyncull/objects/loaders.hpp"
+
+namespace dyncull::cli {
+namespace {
+
+struct InspectOptions {
+    std::string file;
+    std::uint32_t maxLeafTriangles = LocalBspParams{}.maxLeafTriangles;
+    std::uint32_t maxDepth = LocalBspParams{}.maxDepth;
+    std::string method = "median";
+    float nudge = LocalBspParams{}.nudgeFraction;
+};
+
+void runInspect(const InspectOptions& o) {
+    LocalBspParams p;
+    p.maxLeafTriangles = o.maxLeafTriangles;
+    p.maxDepth = o.maxDepth;
+    p.nudgeFraction = o.nudge;
+    if (o.method == "median")
+        p.method = SplitMethod::SpatialMedian;
+    else if (o.method == "sah")
+        p.method = SplitMethod::Sah;
+    else
+        fail("--method: unknown split method '" + o.method + "' (expected median or sah)");
+
+    Stopwatch sw;
+    auto scene = loadScene(o.file);
+    if (!scene) fail(scene.error().message);
+    std::printf("%s: %zu meshes, %zu instances, loaded in %.1f ms\n", o.file.c_str(), scene->meshes.size(),
+                scene->instances.size(), sw.lap());
+    std::printf("%-4s %-28s %10s %10s %7s %7s %6s %9s\n", "mesh", "name", "tris", "tris_after", "added%", "leaves",
+                "depth", "build_ms");
+    std::size_t before = 0, after = 0, leaves = 0;
+    double ms = 0;
+    for (std::size_t i = 0; i < scene->meshes.size(); ++i) {
+        const Mesh& m = scene->meshes[i];
+        auto bsp = buildLocalBsp(m, p);
+        if (!bsp) fail(o.file + ": mesh " + std::to_string(i) + ": " + bsp.error().message);
+        const LocalBspStats& s = bsp->stats;
+        const double added = s.trianglesBefore ? 100.0 * (double(s.trianglesAfter) / double(s.trianglesBefore) - 1.0) : 0.0;
+        std::printf("%-4zu %-28.28s %10zu %10zu %7.2f %7u %6u %9.2f\n", i, m.name.c_str(), s.trianglesBefore,
+                    s.trianglesAfter, added, s.leaves, s.depth, s.buildMs);
+        before += s.trianglesBefore;
+        after += s.trianglesAfter;
+        leaves += s.leaves;
+        ms += s.buildMs;
+    }
+    std::printf("total: %zu triangles -> %zu (%+.2f%%), %zu leaves, %.1f ms building\n", before, after,
+                before ? 100.0 * (double(after) / double(before) - 1.0) : 0.0, leaves, ms);
+}
+
+}  // namespace
+
+void registerInspect(CLI::App& app) {
+    auto o = std::make_shared<InspectOptions>();
+    CLI::App* cmd = app.add_subcommand("inspect", "Build and describe the local BSP of every mesh in a file");
+    cmd->add_option("file", o->file, "Scene file (.ply .obj .gltf .glb)")->required();
+    cmd->add_option("--max-leaf-tris", o->maxLeafTriangles, "Stop splitting at this many triangles")->capture_default_str();
+    cmd->add_option("--max-depth", o->maxDepth, "Maximum tree depth")->capture_default_str();
+    cmd->add_option("--method", o->method, "Split plane: median (spatial median, the paper's) or sah")->capture_default_str();
+    cmd->add_option("--nudge", o->nudge, "Plane nudge window as a fraction of the node extent")->capture_default_str();
+    cmd->callback([o] { runInspect(*o); });
+}
+
+}  // namespace dyncull::cli
