@@ -3,6 +3,7 @@
 // straight lines with seeded velocities and interpenetrating freely; the camera flies a
 // fixed path through and around the swarm.
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 
@@ -15,6 +16,12 @@ namespace dyncull {
 namespace {
 
 namespace fs = std::filesystem;
+
+std::string fmt(float v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", static_cast<double>(v));
+    return buf;
+}
 
 /// Centres the mesh on the origin and scales it so its longest side is `size`.
 void normalise(Mesh& mesh, float size) {
@@ -62,7 +69,7 @@ public:
                        (choice->subdivided ? ", 2 levels of Loop subdivision -> " + std::to_string(triangles) : std::string()) +
                        "); local BSP: " + std::to_string(bsp.stats.leaves) + " parts, " +
                        std::to_string(bsp.stats.trianglesAfter) + " triangles; " + std::to_string(o_.count) +
-                       " bunnies in a box of side " + std::to_string(o_.box);
+                       " bunnies in a box of side " + fmt(o_.box) + ", bunny size " + fmt(o_.bunnySize);
         setupMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         return {};
     }

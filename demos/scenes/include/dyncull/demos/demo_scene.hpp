@@ -40,7 +40,7 @@ protected:
 /// Options of the bunny swarm; every one is a CLI option of `dyncull run bunnies`.
 struct BunnySwarmOptions {
     std::uint32_t count = 300;
-    float box = 12.0f;        ///< side of the cubic box the bunnies move in, world units
+    float box = 9.0f;         ///< side of the cubic box the bunnies move in, world units (dense: bunnies overlap)
     float bunnySize = 1.6f;   ///< longest side of one bunny's bounding box, world units
     float speed = 0.03f;      ///< world units per frame
     std::uint64_t seed = 1;
