@@ -6,6 +6,7 @@
 #include <GLFW/glfw3.h>
 
 #include "dyncull/engine/gl_context.hpp"
+#include "glfw_input.hpp"
 
 namespace dyncull {
 
@@ -42,8 +43,11 @@ public:
         if (w > 0 && h > 0) size_ = {w, h};  // follow user resizes; 0x0 while minimised
     }
     bool shouldClose() const override { return glfwWindowShouldClose(window_) != 0; }
+    InputFrame takeInput() override { return input_.take(); }
+    void setCursorCaptured(bool captured) override { input_.setCursorCaptured(captured); }
 
     GLFWwindow* window_ = nullptr;
+    detail::GlfwInputCollector input_;
 };
 
 }  // namespace
@@ -68,6 +72,7 @@ Expected<std::unique_ptr<GlContext>> createGlfwContext(const ContextOptions& o) 
         return Error{"GLFW: window with OpenGL " + std::to_string(o.glMajor) + "." + std::to_string(o.glMinor) +
                      " core context: " + lastGlfwError()};
     glfwMakeContextCurrent(ctx->window_);
+    ctx->input_.attach(ctx->window_);
     glfwSwapInterval(0);  // measurements must not be paced by vsync
     int w = 0, h = 0;
     glfwGetFramebufferSize(ctx->window_, &w, &h);

@@ -9,6 +9,7 @@
 
 #include <glm/glm.hpp>
 
+#include "dyncull/engine/input.hpp"
 #include "dyncull/objects/error.hpp"
 
 namespace dyncull {
@@ -47,6 +48,12 @@ public:
     virtual void present() = 0;
     /// Windows: the user asked to close. Headless: always false.
     virtual bool shouldClose() const { return false; }
+    /// Windows: keyboard/mouse input gathered by present() since the previous call (held
+    /// keys are current; presses and mouse motion accumulate). Headless: an empty frame.
+    virtual InputFrame takeInput() { return {}; }
+    /// Windows: hide and lock the cursor so mouse motion is unbounded (mouse look); false
+    /// releases it. Headless: no-op.
+    virtual void setCursorCaptured(bool /*captured*/) {}
 
     ContextKind kind() const { return kind_; }
     /// GL name of the framebuffer to render into (0 = the window's default framebuffer).
