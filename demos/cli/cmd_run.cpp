@@ -26,7 +26,7 @@ struct RunOptions {
     std::string screenshot;
     std::vector<std::uint64_t> shots;
     bool window = false;
-    BunnySwarmOptions bunny;
+    SceneOptions sceneOptions;
     SchedulerFlags flags;
 };
 
@@ -47,7 +47,7 @@ void runRun(RunOptions o) {
     if (!size) fail(size.error().message);
     auto mode = parseCullMode(o.mode);
     if (!mode) fail("--mode: " + mode.error().message);
-    auto made = makeScene(o.scene, o.bunny);
+    auto made = makeScene(o.scene, o.sceneOptions);
     if (!made) fail(made.error().message);
     DemoScene& scene = **made;
     if (o.out.empty()) o.out = "out/" + scene.name();
@@ -117,7 +117,7 @@ void runRun(RunOptions o) {
 void registerRun(CLI::App& app) {
     auto o = std::make_shared<RunOptions>();
     CLI::App* cmd = app.add_subcommand("run", "Play a scene's camera path with one culling mode (headless by default)");
-    cmd->add_option("scene", o->scene, "bunnies, or a .ply/.obj/.gltf/.glb file")->capture_default_str();
+    cmd->add_option("scene", o->scene, "bunnies, powerplant, city, a directory of .ply/.obj parts, or a .ply/.obj/.gltf/.glb file")->capture_default_str();
     cmd->add_option("--mode", o->mode, "vfc, simple or full")->capture_default_str();
     cmd->add_option("--frames", o->frames, "frames to run (default: the scene's camera path once)");
     cmd->add_option("--size", o->size, "framebuffer size WxH")->capture_default_str();
@@ -126,7 +126,8 @@ void registerRun(CLI::App& app) {
     cmd->add_option("--screenshot", o->screenshot, "PNG of the last frame (default <out>/last_<mode>.png)");
     cmd->add_option("--shots", o->shots, "also write PNGs of these frames")->delimiter(',');
     cmd->add_flag("--window", o->window, "show a GLFW window instead of rendering headless");
-    addBunnyOptions(*cmd, o->bunny);
+    addBunnyOptions(*cmd, o->sceneOptions.bunny);
+    addGeneratedSceneOptions(*cmd, o->sceneOptions);
     addSchedulerOptions(*cmd, o->flags);
     cmd->callback([o] { runRun(*o); });
 }

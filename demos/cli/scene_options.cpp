@@ -14,6 +14,22 @@ void addBunnyOptions(CLI::App& cmd, BunnySwarmOptions& o) {
     cmd.add_option("--path-frames", o.frames, "bunnies: frames of one pass of the camera path")->capture_default_str();
 }
 
+void addGeneratedSceneOptions(CLI::App& cmd, SceneOptions& o) {
+    cmd.add_option("--scene-dir", o.sceneDir, "powerplant: load every .ply/.obj under this directory instead of generating");
+    cmd.add_option("--cache-dir", o.cache.dir, "powerplant/city: cache directory (default $DYNCULL_CACHE, else out/cache)");
+    cmd.add_flag("--no-cache", [&o](std::int64_t) { o.cache.enabled = false; }, "powerplant/city: always regenerate, never cache");
+    cmd.add_option("--plant-seed", o.plant.seed, "powerplant: generator seed")->capture_default_str();
+    cmd.add_option("--plant-size", o.plant.size, "powerplant: fraction of the objects, (0, 1]")->capture_default_str();
+    cmd.add_option("--plant-detail", o.plant.detail, "powerplant: tessellation factor, (0, 1]")->capture_default_str();
+    cmd.add_option("--city-seed", o.city.seed, "city: generator seed")->capture_default_str();
+    cmd.add_option_function<std::uint32_t>(
+        "--city-blocks", [&o](const std::uint32_t& n) { o.city.blocksX = o.city.blocksZ = n; },
+        "city: blocks along each axis (default 20)");
+    cmd.add_option_function<unsigned>(
+        "--threads", [&o](const unsigned& n) { o.plant.threads = o.city.threads = n; },
+        "powerplant/city: threads for the local BSP builds (default 2)");
+}
+
 void addSchedulerOptions(CLI::App& cmd, SchedulerFlags& f) {
     cmd.add_flag("--no-history", f.noHistory, "full: do not skip queries of recently visible nodes");
     cmd.add_flag("--no-batching", f.noBatching, "full: one query in flight at a time");

@@ -12,6 +12,11 @@ namespace dyncull::cli {
 /// Adds --count --box --bunny-size --speed --seed --orbit --mesh --assets --path-frames.
 void addBunnyOptions(CLI::App& cmd, BunnySwarmOptions& o);
 
+/// Adds the generated-scene options (power plant, city, directory scenes, cache):
+/// --scene-dir --cache-dir --no-cache --plant-seed --plant-size --plant-detail --city-seed
+/// --city-blocks --threads.
+void addGeneratedSceneOptions(CLI::App& cmd, SceneOptions& o);
+
 /// Scheduler switches for `full` ablations and tuning.
 struct SchedulerFlags {
     bool noHistory = false, noBatching = false, noOccupancy = false, noTight = false;

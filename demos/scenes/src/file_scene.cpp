@@ -91,10 +91,31 @@ private:
 
 std::unique_ptr<DemoScene> makeFileScene(const std::string& path) { return std::make_unique<FileScene>(path); }
 
-std::vector<std::string> builtinSceneNames() { return {"bunnies"}; }
+std::vector<std::string> builtinSceneNames() { return {"bunnies", "powerplant", "city"}; }
 
 Expected<std::unique_ptr<DemoScene>> makeScene(const std::string& nameOrPath, const BunnySwarmOptions& bunny) {
-    if (nameOrPath == "bunnies") return makeBunnySwarm(bunny);
+    SceneOptions options;
+    options.bunny = bunny;
+    return makeScene(nameOrPath, options);
+}
+
+Expected<std::unique_ptr<DemoScene>> makeScene(const std::string& nameOrPath, const SceneOptions& options) {
+    if (nameOrPath == "bunnies") return makeBunnySwarm(options.bunny);
+    if (nameOrPath == "powerplant" && !options.sceneDir.empty()) {
+        if (!std::filesystem::is_directory(options.sceneDir)) return Error{options.sceneDir + ": --scene-dir is not a directory"};
+        return makeSceneDir(options.sceneDir);
+    }
+    if (nameOrPath == "powerplant") {
+        PowerPlantOptions plant = options.plant;
+        plant.cache = options.cache;
+        return makePowerPlant(plant);
+    }
+    if (nameOrPath == "city") {
+        CityOptions city = options.city;
+        city.cache = options.cache;
+        return makeCity(city);
+    }
+    if (std::filesystem::is_directory(nameOrPath)) return makeSceneDir(nameOrPath);
     if (std::filesystem::exists(nameOrPath)) return makeFileScene(nameOrPath);
     std::string names;
     for (const std::string& n : builtinSceneNames()) names += (names.empty() ? "" : ", ") + n;

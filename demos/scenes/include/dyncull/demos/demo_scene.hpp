@@ -65,6 +65,54 @@ std::unique_ptr<DemoScene> makeBunnySwarm(const BunnySwarmOptions& options);
 /// outside for compact models, a walkthrough along the long axis for interiors.
 std::unique_ptr<DemoScene> makeFileScene(const std::string& path);
 
+/// Where generated scenes (power plant, city) cache their meshes and local BSPs.
+struct SceneCacheOptions {
+    std::string dir;       ///< empty: $DYNCULL_CACHE, else out/cache
+    bool enabled = true;   ///< false: always generate, never read or write the cache
+};
+
+/// Procedural power plant in the size and character of the UNC Power Plant (about 1,200
+/// objects, 12.7M triangles at size = detail = 1): a multi-storey hall with boilers, tanks,
+/// pipe networks, girders, trusses, catwalks, stairs and machinery. Metres, Y up.
+struct PowerPlantOptions {
+    std::uint64_t seed = 1;
+    float size = 1.0f;    ///< scales the number of objects (small values for tests), (0, 1]
+    float detail = 1.0f;  ///< scales tessellation (segments around tubes, bend steps), (0, 1]
+    std::uint32_t frames = 300;  ///< frames of the default flythrough
+    unsigned threads = 2;        ///< worker threads for the local BSP builds
+    SceneCacheOptions cache;
+};
+
+/// Procedural city: a grid of blocks with one closed building each (furniture-like clutter
+/// on every floor behind the walls), streets, lamps and cars; street-level walk. Metres, Y up.
+struct CityOptions {
+    std::uint64_t seed = 1;
+    std::uint32_t blocksX = 20, blocksZ = 20;  ///< 20 x 20 = 400 buildings
+    std::uint32_t frames = 600;  ///< frames of the default walk
+    unsigned threads = 2;
+    SceneCacheOptions cache;
+};
+
+std::unique_ptr<DemoScene> makePowerPlant(const PowerPlantOptions& options);
+std::unique_ptr<DemoScene> makeCity(const CityOptions& options);
+
+/// Every .ply/.obj file under `dir` (recursively, sorted by relative path) as one static
+/// object each, with an automatic camera (e.g. the UNC Power Plant's PLY parts).
+std::unique_ptr<DemoScene> makeSceneDir(const std::string& dir);
+
+/// Options of every built-in scene, for makeScene.
+struct SceneOptions {
+    BunnySwarmOptions bunny;
+    PowerPlantOptions plant;
+    CityOptions city;
+    SceneCacheOptions cache;  ///< copied into plant and city by makeScene
+    std::string sceneDir;     ///< "powerplant" with a directory: load its PLY/OBJ parts instead
+};
+
+/// Resolves a scene argument: "bunnies", "powerplant", "city", a directory of PLY/OBJ
+/// parts, or a model file.
+Expected<std::unique_ptr<DemoScene>> makeScene(const std::string& nameOrPath, const SceneOptions& options);
+
 /// Resolves a scene argument: "bunnies" (with `bunny` options) or a file path.
 Expected<std::unique_ptr<DemoScene>> makeScene(const std::string& nameOrPath, const BunnySwarmOptions& bunny);
 
