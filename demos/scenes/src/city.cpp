@@ -93,7 +93,7 @@ void interior(MeshBuilder& b, Rng& rng, float w, float d, int floors) {
         // A partition wall and a few furniture groups per floor.
         const float px = rng.uniform(0.3f * w, 0.7f * w);
         b.box({px, y, 0.3f}, {px + 0.12f, y + 2.8f, rng.uniform(0.4f * d, 0.8f * d)});
-        const int items = std::max(2, static_cast<int>(area / 55.0f));
+        const int items = std::max(2, static_cast<int>(area / 80.0f));
         for (int k = 0; k < items; ++k) {
             const glm::vec3 p{rng.uniform(1.5f, w - 1.5f), y, rng.uniform(1.5f, d - 1.5f)};
             const float yaw = 0.5f * kPi * static_cast<float>(rng.range(0, 3));
@@ -235,7 +235,7 @@ private:
 
 std::uint64_t cityParamsHash(const CityOptions& o) {
     char key[160];
-    std::snprintf(key, sizeof key, "city|rev=1|seed=%llu|blocks=%ux%u", static_cast<unsigned long long>(o.seed), o.blocksX,
+    std::snprintf(key, sizeof key, "city|rev=2|seed=%llu|blocks=%ux%u", static_cast<unsigned long long>(o.seed), o.blocksX,
                   o.blocksZ);
     return fnv1a64(key, std::char_traits<char>::length(key));
 }

@@ -223,7 +223,7 @@ private:
             // Serpentine tube bank filling the shell: hidden from outside, so occlusion
             // culling should skip it whenever the shell is in front.
             MeshBuilder b(bank);
-            const int tubes = 110;
+            const int tubes = 200;
             for (int i = 0; i < tubes; ++i) {
                 const float a = 2.0f * kPi * static_cast<float>(i) / static_cast<float>(tubes);
                 const float r = kBoilerR - 0.6f - 1.6f * static_cast<float>(i % 3);
@@ -235,7 +235,7 @@ private:
                     pts.push_back({r * std::cos(a + da), y, r * std::sin(a + da)});
                     pts.push_back({(r - 0.6f) * std::cos(a + da), y + 1.2f, (r - 0.6f) * std::sin(a + da)});
                 }
-                b.tube(pts, 0.035f, seg(10), 0.25f, steps(5));
+                b.tube(pts, 0.035f, seg(12), 0.25f, steps(6));
             }
         }
         {
@@ -317,7 +317,7 @@ private:
         const float rad = r.uniform(1.0f, 2.4f);
         if (variant % 2 == 0) {  // vertical on legs, with ladder and nozzles
             const float h = r.uniform(3.0f, 6.0f);
-            b.tank({0, 1.2f + rad, 0}, {0, 1.2f + rad + h, 0}, rad, seg(64), steps(14));
+            b.tank({0, 1.2f + rad, 0}, {0, 1.2f + rad + h, 0}, rad, seg(96), steps(24));
             for (int k = 0; k < 4; ++k) {
                 const float a = kPi * (0.25f + 0.5f * static_cast<float>(k));
                 const glm::vec3 p{0.85f * rad * std::cos(a), 0, 0.85f * rad * std::sin(a)};
@@ -336,7 +336,7 @@ private:
             }
         } else {  // horizontal on saddles
             const float len = r.uniform(4.0f, 8.0f);
-            b.tank({-0.5f * len, 1.0f + rad, 0}, {0.5f * len, 1.0f + rad, 0}, rad, seg(64), steps(14));
+            b.tank({-0.5f * len, 1.0f + rad, 0}, {0.5f * len, 1.0f + rad, 0}, rad, seg(96), steps(24));
             for (float sx : {-0.3f * len, 0.3f * len}) b.box({sx - 0.3f, 0, -0.8f * rad}, {sx + 0.3f, 1.0f + 0.6f * rad, 0.8f * rad});
             for (int k = 0; k < 4; ++k) {
                 const glm::vec3 p{-0.4f * len + 0.25f * len * static_cast<float>(k), 1.0f + 2.0f * rad - 0.1f, 0};
@@ -359,8 +359,8 @@ private:
         // Motor with cooling fins.
         const float mr = r.uniform(0.35f, 0.6f);
         const glm::vec3 m0{-0.45f * len, 0.45f + mr, 0}, m1{-0.05f * len, 0.45f + mr, 0};
-        b.cylinder(m0, m1, mr, seg(48));
-        const int fins = 36;
+        b.cylinder(m0, m1, mr, seg(96));
+        const int fins = 48;
         for (int k = 0; k < fins; ++k) {
             const float a = 2.0f * kPi * static_cast<float>(k) / static_cast<float>(fins);
             const glm::vec3 d{0, std::cos(a), std::sin(a)};
@@ -370,11 +370,22 @@ private:
         // Coupling guard and pump casing.
         b.cylinder(m1, m1 + glm::vec3(0.1f * len, 0, 0), 0.5f * mr, seg(32));
         const glm::vec3 pc = m1 + glm::vec3(0.1f * len + 0.7f * mr + 0.2f, 0, 0);
-        b.sphere(pc, 0.9f * mr + 0.2f, seg(48), steps(24));
-        for (int k = 0; k < 16; ++k) {  // casing bolts
-            const float a = 2.0f * kPi * static_cast<float>(k) / 16.0f;
+        b.sphere(pc, 0.9f * mr + 0.2f, seg(96), steps(48));
+        for (int k = 0; k < 24; ++k) {  // casing bolts
+            const float a = 2.0f * kPi * static_cast<float>(k) / 24.0f;
             const glm::vec3 q = pc + glm::vec3(-0.2f, (0.9f * mr + 0.25f) * std::cos(a), (0.9f * mr + 0.25f) * std::sin(a));
             b.cylinder(q, q + glm::vec3(0.12f, 0, 0), 0.03f, 8);
+        }
+        // Impeller inside the casing (hidden unless the casing is culled away): curved vanes.
+        for (int k = 0; k < 7; ++k) {
+            const float a = 2.0f * kPi * static_cast<float>(k) / 7.0f;
+            std::vector<glm::vec3> vane;
+            for (int j = 0; j < 4; ++j) {
+                const float rr = 0.1f + 0.2f * static_cast<float>(j) * (0.9f * mr + 0.1f);
+                const float aa = a + 0.35f * static_cast<float>(j);
+                vane.push_back(pc + glm::vec3(0.02f * static_cast<float>(j), rr * std::cos(aa), rr * std::sin(aa)));
+            }
+            b.tube(vane, 0.025f, seg(16), 0.15f, steps(12));
         }
         // Suction and discharge with flanges.
         const float pr = 0.12f + 0.1f * mr;
@@ -488,15 +499,15 @@ private:
 
     void pipe(Mesh& m, const std::vector<glm::vec3>& pts, float r, bool flanges, bool valve) {
         MeshBuilder b(m);
-        const std::uint32_t s = seg(12.0f + 40.0f * r);
-        b.tube(pts, r, s, 3.0f * r, steps(12));
+        const std::uint32_t s = seg(24.0f + 80.0f * r);
+        b.tube(pts, r, s, 3.0f * r, steps(16));
         if (!flanges) return;
         for (std::size_t i = 0; i + 1 < pts.size(); ++i) {
             const glm::vec3 d = pts[i + 1] - pts[i];
             const float len = glm::length(d);
             if (len < 8.0f * r + 1.0f) continue;
             const glm::vec3 u = d / len;
-            for (float t = 4.0f * r + 0.5f; t < len - 4.0f * r - 0.5f; t += 6.0f) {
+            for (float t = 4.0f * r + 0.5f; t < len - 4.0f * r - 0.5f; t += 3.0f) {
                 const glm::vec3 c = pts[i] + u * t;
                 b.cylinder(c - u * 0.04f, c + u * 0.04f, 1.6f * r, s);
             }
@@ -602,7 +613,7 @@ private:
                 }
                 if (route.empty()) continue;
                 Mesh m;
-                rackBundle(m, route, rng_.range(5, 9), rng_.range(1, 2), floorY);
+                rackBundle(m, route, rng_.range(6, 12), rng_.range(1, 3), floorY);
                 place(addMesh(std::move(m), "rack_" + std::to_string(made++)), at({0, 0, 0}));
             }
     }
@@ -698,7 +709,7 @@ private:
 std::uint64_t powerPlantParamsHash(const PowerPlantOptions& o) {
     // Bump the generator revision whenever generated geometry changes.
     char key[160];
-    std::snprintf(key, sizeof key, "powerplant|rev=1|seed=%llu|size=%.6g|detail=%.6g",
+    std::snprintf(key, sizeof key, "powerplant|rev=2|seed=%llu|size=%.6g|detail=%.6g",
                   static_cast<unsigned long long>(o.seed), static_cast<double>(o.size), static_cast<double>(o.detail));
     return fnv1a64(key, std::char_traits<char>::length(key));
 }
