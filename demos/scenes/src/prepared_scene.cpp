@@ -143,7 +143,7 @@ Status GeneratedDemoScene::populate(Engine& engine) {
     for (const PlacedObject& o : prepared->objects) generated += prepared->models[o.model].stats.trianglesBefore;
     if (Status s = populateEngine(engine, prepared.take()); !s) return s;
     description_ = name() + ": " + std::to_string(objectCount_) + " objects, " + std::to_string(modelCount_) +
-                    meshes, " + std::to_string(generated) + " triangles (" + std::to_string(triangles_) +
+                   " meshes, " + std::to_string(generated) + " triangles (" + std::to_string(triangles_) +
                    " after local-BSP splitting); " + log;
     setupMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     return {};
