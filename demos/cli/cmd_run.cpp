@@ -11,6 +11,7 @@
 #include "dyncull/demos/demo_scene.hpp"
 #include "dyncull/engine/engine.hpp"
 #include "dyncull/engine/image.hpp"
+#include "interactive.hpp"
 #include "scene_options.hpp"
 
 namespace dyncull::cli {
@@ -26,6 +27,7 @@ struct RunOptions {
     std::string screenshot;
     std::vector<std::uint64_t> shots;
     bool window = false;
+    bool boxes = false;
     SceneOptions sceneOptions;
     SchedulerFlags flags;
 };
@@ -40,6 +42,16 @@ void writeCsvRow(std::ofstream& f, std::uint64_t frame, const FrameStats& s) {
       << ',' << s.queriesIssued << ',' << s.queriesOccluded << ',' << s.skippedByHistory << ',' << s.skippedByOccupancy
       << ',' << s.visibleNearOrInside << ',' << s.frustumCulled << ',' << s.nodesVisited << ',' << s.batches << ','
       << s.partsDrawn << ',' << s.trianglesDrawn << '\n';
+}
+
+// Node-box view of a headless frame, for screenshots: boxes, stats line and legend.
+void drawNodeBoxOverlay(NodeBoxView& view, Engine& engine, const FrameStats& s, const std::string& mode) {
+    const std::size_t n = view.drawBoxes(engine, NodeBoxFilter{});
+    char line[256];
+    std::snprintf(line, sizeof line, "%s  %.2f ms  queries %u  occluded %u  parts %u  tris %s  boxes %zu", mode.c_str(),
+                  s.frameMs, s.queriesIssued, s.queriesOccluded, s.partsDrawn,
+                  compactCount(static_cast<double>(s.trianglesDrawn)).c_str(), n);
+    view.drawText(engine, {line}, true);
 }
 
 void runRun(RunOptions o) {
@@ -73,6 +85,22 @@ void runRun(RunOptions o) {
     std::printf("%s\n", scene.description().c_str());
     std::printf("context: %s, %s; set-up %.0f ms\n", ctx.platformName().c_str(), ctx.rendererName().c_str(), scene.setupMs());
 
+    if (o.window) {  // interactive viewer: free flight, live mode switches, node boxes
+        InteractiveOptions io;
+        io.params = eo.scheduler;
+        io.maxFrames = o.frames;
+        io.boxes = o.boxes;
+        ContextInput input(ctx);
+        InteractiveState last;
+        auto n = runInteractive(ctx, engine, scene, input, io, &last);
+        if (!n) fail(n.error().message);
+        std::printf("summary scene=%s mode=%s frames=%llu\n", scene.name().c_str(), toString(last.mode),
+                    static_cast<unsigned long long>(*n));
+        return;
+    }
+    std::unique_ptr<NodeBoxView> boxView;
+    if (o.boxes) boxView = std::make_unique<NodeBoxView>();
+
     const std::uint64_t frames = o.frames ? o.frames : scene.defaultFrames();
     if (Status s = ensureParentDirectory(o.stats); !s) fail(s.message());
     std::ofstream csv(o.stats);
@@ -86,7 +114,9 @@ void runRun(RunOptions o) {
     for (; frame < frames && !ctx.shouldClose(); ++frame) {
         if (Status s = scene.update(engine, frame); !s) fail(s.message());
         if (Status s = engine.setCamera(scene.camera(frame, aspect)); !s) fail(s.message());
+        if (boxView) boxView->trace(engine.scheduler(), true);
         const FrameStats st = engine.renderFrame();
+        if (boxView) drawNodeBoxOverlay(*boxView, engine, st, o.mode);
         writeCsvRow(csv, frame, st);
         ms += st.frameMs;
         queries += st.queriesIssued;
@@ -125,7 +155,8 @@ void registerRun(CLI::App& app) {
     cmd->add_option("--stats", o->stats, "per-frame CSV (default <out>/frames_<mode>.csv)");
     cmd->add_option("--screenshot", o->screenshot, "PNG of the last frame (default <out>/last_<mode>.png)");
     cmd->add_option("--shots", o->shots, "also write PNGs of these frames")->delimiter(',');
-    cmd->add_flag("--window", o->window, "show a GLFW window instead of rendering headless");
+    cmd->add_flag("--window", o->window, "interactive GLFW window (fly, 1/2/3 modes, B node boxes; --frames limits it)");
+    cmd->add_flag("--boxes", o->boxes, "draw the node-box view (scheduler decisions) and stats over each frame");
     addBunnyOptions(*cmd, o->sceneOptions.bunny);
     addGeneratedSceneOptions(*cmd, o->sceneOptions);
     addSchedulerOptions(*cmd, o->flags);
