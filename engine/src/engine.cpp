@@ -1,5 +1,6 @@
 #include "dyncull/engine/engine.hpp"
 
+#include <cassert>
 #include <chrono>
 
 #include <epoxy/gl.h>
@@ -11,6 +12,7 @@ struct Engine::Sink final : PartSink {
     explicit Sink(Engine& engine) : e(engine) {}
     void drawPart(std::uint32_t object, std::uint32_t firstIndex, std::uint32_t indexCount) override {
         const SceneObjects& objs = e.objects_;
+        if (e.observer_) e.observer_(object, firstIndex, indexCount);
         const ModelId model = objs.modelOf(object);
         if (e.callback_) {
             e.callback_(objs.handle(object), model, firstIndex, indexCount, objs.matrix(object));
@@ -106,6 +108,32 @@ FrameStats Engine::renderFrame(QueryScheduler& scheduler) {
     TwoLevelTree tree(tree_, objects_);
     const glm::ivec2 size = context_.size();
     FrameStats st = scheduler.cullFrame(tree, camera_, size.x, size.y, *backend_, sink);
+    renderer_->endFrame();
+    if (finishEachFrame_) glFinish();
+    st.updateMs = updateMs;
+    st.frameMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    return st;
+}
+
+FrameStats Engine::renderParts(const std::vector<NodeRef>& parts) {
+    using Clock = std::chrono::steady_clock;
+    const auto t0 = Clock::now();
+    const double updateMs = updateSceneTree().updateMs;
+    renderer_->beginFrame(camera_);
+    Sink sink(*this);
+    FrameStats st;
+    const auto tDraw = Clock::now();
+    for (const NodeRef& ref : parts) {
+        assert(!ref.isSceneNode() && ref.object < objects_.slotCount() && objects_.alive(ref.object));
+        const LocalBsp& bsp = objects_.model(objects_.modelOf(ref.object));
+        assert(ref.node < bsp.nodes.size());
+        const LocalBspNode& n = bsp.nodes[ref.node];
+        sink.drawPart(ref.object, n.firstIndex, n.indexCount);
+        ++st.partsDrawn;
+        st.trianglesDrawn += n.indexCount / 3;
+    }
+    st.drawMs = std::chrono::duration<double, std::milli>(Clock::now() - tDraw).count();
+    st.nodesVisited = st.partsDrawn;
     renderer_->endFrame();
     if (finishEachFrame_) glFinish();
     st.updateMs = updateMs;

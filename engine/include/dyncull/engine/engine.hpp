@@ -34,6 +34,10 @@ using DrawPartCallback =
     std::function<void(ObjectHandle object, ModelId model, std::uint32_t firstIndex, std::uint32_t indexCount,
                        const glm::mat4& objectToWorld)>;
 
+/// Told about every part drawn, before it is drawn (whoever draws it): object slot and the
+/// index range of its model's split mesh. For measurement (which parts a mode drew).
+using PartObserver = std::function<void(std::uint32_t object, std::uint32_t firstIndex, std::uint32_t indexCount)>;
+
 /// Borrows the GL context (which must outlive the Engine and be current on calls).
 class Engine {
 public:
@@ -62,6 +66,12 @@ public:
     /// The same with another scheduler (its own mode, parameters and visibility history),
     /// so several configurations can be run interleaved over the same frames of one scene.
     FrameStats renderFrame(QueryScheduler& scheduler);
+    /// Draws exactly `parts` (local-BSP nodes: object slot, node), in the given order, with
+    /// no culling and no queries, timed like renderFrame (the oracle lower bound of `dyncull
+    /// bench`). Every ref must name a live object and a node of its model.
+    FrameStats renderParts(const std::vector<NodeRef>& parts);
+    /// Observer of drawn parts (nullptr removes it); see PartObserver.
+    void setPartObserver(PartObserver observer) { observer_ = std::move(observer); }
     /// Relinks moved objects now (renderFrame does it too; calling twice costs nothing).
     LooseBspFrameStats updateSceneTree();
     /// When false, renderFrame skips the final glFinish (frameMs then excludes GPU time).
@@ -92,6 +102,7 @@ private:
     std::vector<glm::vec3> colour_;  // per object slot
     std::vector<std::uint8_t> hasColour_;
     DrawPartCallback callback_;
+    PartObserver observer_;
     bool finishEachFrame_ = true;
 };
 

@@ -1,0 +1,119 @@
+// Exact visibility of object parts for measuring culling modes: an ID pass draws every
+// local-BSP leaf of every live object that is not outside the frustum (no occlusion
+// culling) with its part id into an integer target, depth-tested exactly like the
+// renderer (same positions, matrices, GL_LESS, 32-bit float depth), and reads it back.
+// A part is visible iff it owns at least one pixel; its pixel count comes with it.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "dyncull/bsp/scene_objects.hpp"
+#include "dyncull/bsp/traversal.hpp"
+#include "dyncull/objects/camera.hpp"
+#include "dyncull/objects/error.hpp"
+
+namespace dyncull {
+
+class Engine;
+class GlContext;
+
+/// A drawable part: object slot of SceneObjects and a local-BSP node of its model.
+struct PartKey {
+    std::uint32_t object = 0;
+    std::uint32_t node = 0;
+    friend bool operator==(const PartKey&, const PartKey&) = default;
+    friend bool operator<(const PartKey& a, const PartKey& b) {
+        return a.object != b.object ? a.object < b.object : a.node < b.node;
+    }
+};
+
+/// The parts visible in one frame, sorted by key, with the pixels each covers.
+struct VisibleSet {
+    std::vector<PartKey> parts;          ///< sorted ascending, unique
+    std::vector<std::uint32_t> pixels;   ///< pixels[i]: pixels part i owns (> 0)
+    std::uint64_t coveredPixels = 0;     ///< sum of pixels (pixels showing any part)
+    std::uint32_t candidates = 0;        ///< parts drawn by the ID pass (not outside the frustum)
+
+    /// Pixels of `key`, 0 if not visible. O(log n).
+    std::uint32_t pixelsOf(PartKey key) const;
+    bool contains(PartKey key) const { return pixelsOf(key) > 0; }
+};
+
+/// Owns an FBO (R32UI ids + DEPTH32F) the size of the context and its own copy of every
+/// model's positions and indices (uploaded on first use; models are never removed). The
+/// GlContext must outlive it and be current on every call. Leaves the context's
+/// framebuffer bound afterwards; other GL state the renderer sets per frame anyway.
+class GroundTruth {
+public:
+    static Expected<std::unique_ptr<GroundTruth>> create(GlContext& context);
+    ~GroundTruth();
+    GroundTruth(const GroundTruth&) = delete;
+    GroundTruth& operator=(const GroundTruth&) = delete;
+
+    /// The exact visible set of the engine's scene from `camera` (world space; the aspect
+    /// should match the context). Uses the objects' current matrices.
+    VisibleSet compute(const Engine& engine, const Camera& camera);
+    VisibleSet compute(const SceneObjects& objects, const Camera& camera);
+
+    /// Ids of the last compute, top-down rows, width x height: 0 = background, else
+    /// 1 + index into lastParts().
+    const std::vector<std::uint32_t>& idImage() const { return ids_; }
+    /// The per-frame part list the ids index (frustum-culled leaves, slot then node order).
+    const std::vector<NodeRef>& lastParts() const { return candidates_; }
+    /// Milliseconds of the last compute (draw + readback + counting).
+    double lastMs() const { return lastMs_; }
+
+private:
+    explicit GroundTruth(GlContext& context) : context_(context) {}
+    void uploadModels(const SceneObjects& objects);
+
+    struct GpuModel {
+        std::uint32_t vao = 0, vbo = 0, ibo = 0;
+    };
+    GlContext& context_;
+    std::uint32_t fbo_ = 0, colour_ = 0, depth_ = 0, program_ = 0;
+    int locViewProj_ = -1, locModel_ = -1, locId_ = -1;
+    int width_ = 0, height_ = 0;
+    std::vector<GpuModel> models_;
+    std::vector<NodeRef> candidates_;
+    std::vector<std::uint32_t> ids_;
+    std::vector<std::uint32_t> counts_;
+    double lastMs_ = 0.0;
+};
+
+/// Turns the index ranges a mode drew (PartSink / Engine::setPartObserver calls) into the
+/// non-empty leaves they cover. Keeps a per-model index of leaves by first index.
+class DrawnPartRecorder {
+public:
+    /// Starts a new frame's record.
+    void clear() {
+        drawn_.clear();
+        sorted_ = true;
+    }
+    /// Records the range [firstIndex, firstIndex + indexCount) of object slot `object`.
+    void record(const SceneObjects& objects, std::uint32_t object, std::uint32_t firstIndex, std::uint32_t indexCount);
+    /// The leaves drawn this frame, sorted and unique (sorts on call).
+    const std::vector<PartKey>& drawn();
+
+private:
+    struct LeafStart {
+        std::uint32_t firstIndex, node;
+    };
+    std::vector<std::vector<LeafStart>> leaves_;  // per model, ascending firstIndex
+    std::vector<PartKey> drawn_;
+    bool sorted_ = true;
+};
+
+/// How a drawn set differs from the visible set.
+struct PartErrors {
+    std::uint32_t falseNegatives = 0;        ///< visible parts not drawn
+    std::uint64_t falseNegativePixels = 0;   ///< pixels those parts own in the ground truth
+    std::uint32_t falsePositives = 0;        ///< drawn parts with no visible pixel
+    std::uint32_t drawn = 0;
+};
+/// `drawn` sorted and unique (DrawnPartRecorder::drawn).
+PartErrors compareParts(const VisibleSet& truth, const std::vector<PartKey>& drawn);
+
+}  // namespace dyncull

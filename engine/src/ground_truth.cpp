@@ -1,0 +1,228 @@
+// Ground-truth visibility by an ID pass (see ground_truth.hpp), and the bookkeeping that
+// compares what a culling mode drew against it.
+#include "dyncull/engine/ground_truth.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <chrono>
+
+#include <epoxy/gl.h>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "dyncull/engine/engine.hpp"
+#include "dyncull/engine/gl_context.hpp"
+#include "shader_program.hpp"
+
+namespace dyncull {
+namespace {
+
+// The vertex stage repeats the lit shader's arithmetic exactly (world = model * p, then
+// viewProj * world) so both passes produce bit-identical positions and depths. No
+// `invariant` qualifier: the lit shader has none, and it may change how the driver
+// compiles the expression (e.g. forbid fused multiply-adds the lit shader gets).
+const char* const kIdVertexShader = R"(#version 450 core
+layout(location = 0) in vec3 aPosition;
+uniform mat4 uViewProj;
+uniform mat4 uModel;
+void main() {
+    vec4 world = uModel * vec4(aPosition, 1.0);
+    gl_Position = uViewProj * world;
+}
+)";
+
+const char* const kIdFragmentShader = R"(#version 450 core
+uniform uint uId;
+layout(location = 0) out uint outId;
+void main() { outId = uId; }
+)";
+
+}  // namespace
+
+std::uint32_t VisibleSet::pixelsOf(PartKey key) const {
+    const auto it = std::lower_bound(parts.begin(), parts.end(), key);
+    if (it == parts.end() || !(*it == key)) return 0;
+    return pixels[static_cast<std::size_t>(it - parts.begin())];
+}
+
+Expected<std::unique_ptr<GroundTruth>> GroundTruth::create(GlContext& context) {
+    std::unique_ptr<GroundTruth> g(new GroundTruth(context));
+    std::string log;
+    g->program_ = detail::buildProgram(kIdVertexShader, kIdFragmentShader, log);
+    if (!g->program_) return Error{"ground truth: id shader rejected by " + context.rendererName() + ": " + log};
+    g->locViewProj_ = glGetUniformLocation(g->program_, "uViewProj");
+    g->locModel_ = glGetUniformLocation(g->program_, "uModel");
+    g->locId_ = glGetUniformLocation(g->program_, "uId");
+    return g;
+}
+
+GroundTruth::~GroundTruth() {
+    for (GpuModel& m : models_) {
+        glDeleteVertexArrays(1, &m.vao);
+        glDeleteBuffers(1, &m.vbo);
+        glDeleteBuffers(1, &m.ibo);
+    }
+    if (fbo_) glDeleteFramebuffers(1, &fbo_);
+    if (colour_) glDeleteTextures(1, &colour_);
+    if (depth_) glDeleteTextures(1, &depth_);
+    if (program_) glDeleteProgram(program_);
+}
+
+void GroundTruth::uploadModels(const SceneObjects& objects) {
+    for (ModelId id = static_cast<ModelId>(models_.size()); id < objects.modelCount(); ++id) {
+        const Mesh& mesh = objects.model(id).mesh;
+        GpuModel g;
+        const auto vbytes = static_cast<GLsizeiptr>(mesh.positions.size() * sizeof(glm::vec3));
+        const auto ibytes = static_cast<GLsizeiptr>(mesh.indices.size() * sizeof(std::uint32_t));
+        // Storage must be non-zero sized; an empty mesh still gets valid (1-byte) buffers.
+        glCreateBuffers(1, &g.vbo);
+        glNamedBufferStorage(g.vbo, vbytes ? vbytes : 1, vbytes ? mesh.positions.data() : nullptr, 0);
+        glCreateBuffers(1, &g.ibo);
+        glNamedBufferStorage(g.ibo, ibytes ? ibytes : 1, ibytes ? mesh.indices.data() : nullptr, 0);
+        glCreateVertexArrays(1, &g.vao);
+        glVertexArrayVertexBuffer(g.vao, 0, g.vbo, 0, sizeof(glm::vec3));
+        glVertexArrayElementBuffer(g.vao, g.ibo);
+        glEnableVertexArrayAttrib(g.vao, 0);
+        glVertexArrayAttribFormat(g.vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
+        glVertexArrayAttribBinding(g.vao, 0, 0);
+        models_.push_back(g);
+    }
+}
+
+VisibleSet GroundTruth::compute(const Engine& engine, const Camera& camera) {
+    return compute(engine.objects(), camera);
+}
+
+VisibleSet GroundTruth::compute(const SceneObjects& objects, const Camera& camera) {
+    const auto t0 = std::chrono::steady_clock::now();
+    uploadModels(objects);
+    const glm::ivec2 size = context_.size();
+    if (size.x != width_ || size.y != height_ || !fbo_) {
+        if (fbo_) glDeleteFramebuffers(1, &fbo_);
+        if (colour_) glDeleteTextures(1, &colour_);
+        if (depth_) glDeleteTextures(1, &depth_);
+        width_ = size.x;
+        height_ = size.y;
+        glCreateTextures(GL_TEXTURE_2D, 1, &colour_);
+        glTextureStorage2D(colour_, 1, GL_R32UI, width_, height_);
+        // Same depth format as the context's FBO, so depth ties resolve identically.
+        glCreateTextures(GL_TEXTURE_2D, 1, &depth_);
+        glTextureStorage2D(depth_, 1, GL_DEPTH_COMPONENT32F, width_, height_);
+        glCreateFramebuffers(1, &fbo_);
+        glNamedFramebufferTexture(fbo_, GL_COLOR_ATTACHMENT0, colour_, 0);
+        glNamedFramebufferTexture(fbo_, GL_DEPTH_ATTACHMENT, depth_, 0);
+    }
+
+    const glm::mat4 viewProj = camera.viewProjection();
+    candidates_ = frustumLeavesBruteForce(objects, Frustum::fromMatrix(viewProj));
+
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    glViewport(0, 0, width_, height_);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE);  // as the renderer: both sides of every triangle
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    const GLuint zero[4] = {0, 0, 0, 0};
+    glClearBufferuiv(GL_COLOR, 0, zero);
+    const GLfloat one = 1.0f;
+    glClearBufferfv(GL_DEPTH, 0, &one);
+    glUseProgram(program_);
+    glUniformMatrix4fv(locViewProj_, 1, GL_FALSE, glm::value_ptr(viewProj));
+    for (std::size_t i = 0; i < candidates_.size(); ++i) {
+        const NodeRef ref = candidates_[i];
+        const ModelId model = objects.modelOf(ref.object);
+        const LocalBspNode& n = objects.model(model).nodes[ref.node];
+        if (n.indexCount == 0) continue;
+        glUniform1ui(locId_, static_cast<GLuint>(i + 1));
+        glUniformMatrix4fv(locModel_, 1, GL_FALSE, glm::value_ptr(objects.matrix(ref.object)));
+        glBindVertexArray(models_[model].vao);
+        glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(n.indexCount), GL_UNSIGNED_INT,
+                       reinterpret_cast<const void*>(static_cast<std::uintptr_t>(n.firstIndex) * sizeof(std::uint32_t)));
+    }
+    glBindVertexArray(0);
+
+    const std::size_t rowPixels = static_cast<std::size_t>(width_);
+    std::vector<std::uint32_t> bottomUp(rowPixels * static_cast<std::size_t>(height_));
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glReadPixels(0, 0, width_, height_, GL_RED_INTEGER, GL_UNSIGNED_INT, bottomUp.data());
+    glBindFramebuffer(GL_FRAMEBUFFER, context_.framebuffer());
+    context_.checkErrors();
+
+    ids_.resize(bottomUp.size());
+    for (int y = 0; y < height_; ++y)  // GL rows start at the bottom; idImage is top-down
+        std::copy_n(bottomUp.data() + static_cast<std::size_t>(height_ - 1 - y) * rowPixels, rowPixels,
+                    ids_.data() + static_cast<std::size_t>(y) * rowPixels);
+
+    counts_.assign(candidates_.size() + 1, 0);
+    for (std::uint32_t id : ids_)
+        if (id <= candidates_.size()) ++counts_[id];  // larger ids cannot occur; ignored defensively
+    VisibleSet vs;
+    vs.candidates = static_cast<std::uint32_t>(candidates_.size());
+    for (std::size_t i = 0; i < candidates_.size(); ++i) {
+        if (counts_[i + 1] == 0) continue;
+        vs.parts.push_back({candidates_[i].object, candidates_[i].node});
+        vs.pixels.push_back(counts_[i + 1]);
+        vs.coveredPixels += counts_[i + 1];
+    }
+    // frustumLeavesBruteForce lists slot then node order, so parts are already sorted.
+    assert(std::is_sorted(vs.parts.begin(), vs.parts.end()));
+    lastMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    return vs;
+}
+
+void DrawnPartRecorder::record(const SceneObjects& objects, std::uint32_t object, std::uint32_t firstIndex,
+                               std::uint32_t indexCount) {
+    const ModelId model = objects.modelOf(object);
+    if (leaves_.size() <= model) leaves_.resize(model + 1);
+    std::vector<LeafStart>& leaves = leaves_[model];
+    const LocalBsp& bsp = objects.model(model);
+    if (leaves.empty()) {
+        // Depth-first node order keeps leaf ranges ascending; empty leaves own no pixels.
+        for (std::uint32_t i = 0; i < bsp.nodes.size(); ++i)
+            if (bsp.nodes[i].isLeaf() && (bsp.nodes[i].indexCount > 0 || bsp.nodes.size() == 1))
+                leaves.push_back({bsp.nodes[i].firstIndex, i});
+    }
+    // Every leaf whose range starts inside the drawn range (a leaf, or a whole subtree).
+    auto it = std::lower_bound(leaves.begin(), leaves.end(), firstIndex,
+                               [](const LeafStart& l, std::uint32_t v) { return l.firstIndex < v; });
+    const std::uint64_t end = static_cast<std::uint64_t>(firstIndex) + indexCount;
+    for (; it != leaves.end() && (it->firstIndex < end || (indexCount == 0 && it->firstIndex == firstIndex)); ++it) {
+        if (drawn_.size() && sorted_ && !(drawn_.back() < PartKey{object, it->node})) sorted_ = false;
+        drawn_.push_back({object, it->node});
+        if (indexCount == 0) break;
+    }
+}
+
+const std::vector<PartKey>& DrawnPartRecorder::drawn() {
+    if (!sorted_) {
+        std::sort(drawn_.begin(), drawn_.end());
+        drawn_.erase(std::unique(drawn_.begin(), drawn_.end()), drawn_.end());
+        sorted_ = true;
+    }
+    return drawn_;
+}
+
+PartErrors compareParts(const VisibleSet& truth, const std::vector<PartKey>& drawn) {
+    PartErrors e;
+    e.drawn = static_cast<std::uint32_t>(drawn.size());
+    std::size_t i = 0, j = 0;  // merge of two sorted lists
+    while (i < truth.parts.size() || j < drawn.size()) {
+        if (j == drawn.size() || (i < truth.parts.size() && truth.parts[i] < drawn[j])) {
+            ++e.falseNegatives;
+            e.falseNegativePixels += truth.pixels[i];
+            ++i;
+        } else if (i == truth.parts.size() || drawn[j] < truth.parts[i]) {
+            ++e.falsePositives;
+            ++j;
+        } else {
+            ++i;
+            ++j;
+        }
+    }
+    return e;
+}
+
+}  // namespace dyncull
