@@ -10,5 +10,7 @@ namespace dyncull::cli {
 void registerView(CLI::App& app);
 void registerRun(CLI::App& app);
 void registerInspect(CLI::App& app);
+void registerBench(CLI::App& app);
+void registerSweep(CLI::App& app);
 
 }  // namespace dyncull::cli

@@ -9,6 +9,8 @@ int main(int argc, char** argv) {
     dyncull::cli::registerView(app);
     dyncull::cli::registerRun(app);
     dyncull::cli::registerInspect(app);
+    dyncull::cli::registerBench(app);
+    dyncull::cli::registerSweep(app);
     CLI11_PARSE(app, argc, argv);
     return 0;
 }

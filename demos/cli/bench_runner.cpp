@@ -1,0 +1,298 @@
+// Interleaved measurement of culling modes against ground truth (see bench_runner.hpp).
+#include "bench_runner.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cstdio>
+#include <filesystem>
+
+#include "dyncull/bsp/traversal.hpp"
+#include "dyncull/engine/gl_context.hpp"
+#include "report_writer.hpp"
+
+namespace dyncull::cli {
+namespace {
+
+/// Whole string as an unsigned 32-bit number, or false.
+bool parseU32(const std::string& s, std::uint32_t& out) {
+    if (s.empty()) return false;
+    const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
+    return ec == std::errc() && p == s.data() + s.size();
+}
+
+/// "thr16" -> 16 for prefix "thr".
+bool numberAfter(const std::string& name, const std::string& prefix, std::uint32_t& out) {
+    return name.size() > prefix.size() && name.compare(0, prefix.size(), prefix) == 0 &&
+           parseU32(name.substr(prefix.size()), out);
+}
+
+std::vector<std::string> splitCommas(const std::string& s) {
+    std::vector<std::string> out;
+    std::size_t start = 0;
+    while (start <= s.size()) {
+        const std::size_t comma = s.find(',', start);
+        const std::size_t end = comma == std::string::npos ? s.size() : comma;
+        out.push_back(s.substr(start, end - start));
+        if (comma == std::string::npos) break;
+        start = comma + 1;
+    }
+    return out;
+}
+
+ModeSpec fullMode(const std::string& name) {
+    ModeSpec m;
+    m.name = name;
+    m.scheduler.mode = CullMode::Full;
+    return m;
+}
+
+}  // namespace
+
+std::string modeNamesHelp() {
+    return "vfc, simple, full, oracle; approximate: thrN (pixel threshold), latency1 (last frame's results), "
+           "skipN (history max skip N, 2 per visible), overlap (overlapping batches), smallN (small-feature pixels); "
+           "ablations: full-nohist, full-nobatch, full-noocc, full-notight";
+}
+
+Expected<ModeSpec> modeFromName(const std::string& name) {
+    ModeSpec m = fullMode(name);
+    std::uint32_t n = 0;
+    if (name == "vfc") {
+        m.scheduler.mode = CullMode::Vfc;
+    } else if (name == "simple") {
+        m.scheduler.mode = CullMode::Simple;
+    } else if (name == "full") {
+    } else if (name == "oracle") {
+        m.oracle = true;
+    } else if (name == "latency1") {
+        m.scheduler.useLastFrameResults = true;
+    } else if (name == "overlap") {
+        m.scheduler.batchOverlapping = true;
+    } else if (name == "full-nohist") {
+        m.scheduler.useHistory = false;
+    } else if (name == "full-nobatch") {
+        m.scheduler.useBatching = false;
+    } else if (name == "full-noocc") {
+        m.scheduler.useOccupancyAccept = false;
+    } else if (name == "full-notight") {
+        m.scheduler.useTightVolumes = false;
+    } else if (numberAfter(name, "thr", n)) {
+        m.queries.visiblePixelThreshold = n;
+    } else if (numberAfter(name, "skip", n)) {
+        m.scheduler.history.maxSkipFrames = n;
+        m.scheduler.history.skipFramesPerVisible = 2;
+    } else if (numberAfter(name, "small", n)) {
+        m.scheduler.smallFeaturePixels = n;
+    } else {
+        return Error{"--modes: unknown mode '" + name + "' (known: " + modeNamesHelp() + ")"};
+    }
+    if (Status s = validateSchedulerParams(m.scheduler); !s) return Error{"--modes: " + name + ": " + s.message()};
+    return m;
+}
+
+Expected<std::vector<ModeSpec>> modesFromList(const std::string& list) {
+    std::vector<ModeSpec> out;
+    for (const std::string& name : splitCommas(list)) {
+        if (name.empty()) return Error{"--modes: empty mode name in '" + list + "'"};
+        for (const ModeSpec& m : out)
+            if (m.name == name) return Error{"--modes: '" + name + "' given twice"};
+        auto m = modeFromName(name);
+        if (!m) return m.error();
+        out.push_back(m.take());
+    }
+    return out;
+}
+
+std::string sweepParamsHelp() {
+    return "pixel-threshold, max-skip, skip-per-visible, small-feature, max-in-flight, tile-size";
+}
+
+Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec) {
+    const std::size_t eq = spec.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == spec.size())
+        return Error{"--param: expected NAME=v1,v2,... (NAME one of " + sweepParamsHelp() + "), got '" + spec + "'"};
+    const std::string param = spec.substr(0, eq);
+    std::vector<ModeSpec> out;
+    for (const std::string& text : splitCommas(spec.substr(eq + 1))) {
+        std::uint32_t v = 0;
+        if (!parseU32(text, v)) return Error{"--param " + param + ": '" + text + "' is not a non-negative integer"};
+        ModeSpec m = fullMode(param + "=" + text);
+        if (param == "pixel-threshold") {
+            m.queries.visiblePixelThreshold = v;
+        } else if (param == "max-skip") {
+            m.scheduler.history.maxSkipFrames = v;
+        } else if (param == "skip-per-visible") {
+            m.scheduler.history.skipFramesPerVisible = v;
+        } else if (param == "small-feature") {
+            m.scheduler.smallFeaturePixels = v;
+        } else if (param == "max-in-flight") {
+            m.scheduler.maxQueriesInFlight = v;
+        } else if (param == "tile-size") {
+            m.scheduler.occupancyTileSize = static_cast<int>(std::min<std::uint32_t>(v, 1u << 20));
+        } else {
+            return Error{"--param: unknown parameter '" + param + "' (known: " + sweepParamsHelp() + ")"};
+        }
+        if (Status s = validateSchedulerParams(m.scheduler); !s) return Error{"--param " + m.name + ": " + s.message()};
+        for (const ModeSpec& o : out)
+            if (o.name == m.name) return Error{"--param: value " + text + " given twice"};
+        out.push_back(std::move(m));
+    }
+    return out;
+}
+
+Expected<std::unique_ptr<BenchRunner>> BenchRunner::create(Engine& engine, DemoScene& scene, std::vector<ModeSpec> modes) {
+    std::unique_ptr<BenchRunner> r(new BenchRunner(engine, scene));
+    // vfc renders first each frame: its image is the reference the others are compared to.
+    const auto vfc = std::find_if(modes.begin(), modes.end(), [](const ModeSpec& m) {
+        return !m.oracle && m.scheduler.mode == CullMode::Vfc;
+    });
+    if (vfc == modes.end()) {
+        auto m = modeFromName("vfc");
+        modes.insert(modes.begin(), m.take());
+    } else {
+        std::rotate(modes.begin(), vfc, vfc + 1);
+    }
+    for (const ModeSpec& m : modes) {
+        if (Status s = validateSchedulerParams(m.scheduler); !s) return Error{m.name + ": " + s.message()};
+        r->schedulers_.push_back(m.oracle ? nullptr : std::make_unique<QueryScheduler>(m.scheduler));
+    }
+    auto gt = GroundTruth::create(engine.context());
+    if (!gt) return gt.error();
+    r->groundTruth_ = gt.take();
+    BenchResult& res = r->result_;
+    res.modes = std::move(modes);
+    res.scene = scene.name();
+    res.description = scene.description();
+    res.renderer = engine.context().rendererName();
+    res.width = engine.context().size().x;
+    res.height = engine.context().size().y;
+    r->images_.resize(res.modes.size());
+    return r;
+}
+
+Status BenchRunner::runFrame(std::uint64_t frame) {
+    const glm::ivec2 size = engine_.context().size();
+    const float aspect = static_cast<float>(size.x) / static_cast<float>(size.y);
+    if (Status s = scene_.update(engine_, frame); !s) return s;
+    if (Status s = engine_.setCamera(scene_.camera(frame, aspect)); !s) return s;
+
+    // Relink once for all modes, so no mode pays for the others' motion.
+    FrameTruth ft;
+    ft.updateMs = engine_.updateSceneTree().updateMs;
+    truth_ = groundTruth_->compute(engine_, engine_.camera());
+    ft.groundTruthMs = groundTruth_->lastMs();
+    ft.visibleParts = static_cast<std::uint32_t>(truth_.parts.size());
+    ft.frustumParts = truth_.candidates;
+    ft.coveredPixels = truth_.coveredPixels;
+
+    // The oracle draws the visible parts front-to-back like the other modes, so it gets
+    // the same early-depth rejection and is a fair lower bound.
+    const TwoLevelTree tree(engine_.sceneTree(), engine_.objects());
+    const glm::vec3 eye = engine_.camera().position;
+    std::vector<std::pair<float, NodeRef>> byDistance;
+    byDistance.reserve(truth_.parts.size());
+    for (const PartKey& k : truth_.parts) {
+        const NodeRef ref{k.object, k.node};
+        const glm::vec3 d = tree.worldBox(ref).center() - eye;
+        byDistance.push_back({glm::dot(d, d), ref});
+    }
+    std::sort(byDistance.begin(), byDistance.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    oracleParts_.clear();
+    for (const auto& p : byDistance) oracleParts_.push_back(p.second);
+
+    const SceneObjects& objects = engine_.objects();
+    engine_.setPartObserver([this, &objects](std::uint32_t object, std::uint32_t first, std::uint32_t count) {
+        recorder_.record(objects, object, first, count);
+    });
+    std::vector<ModeFrame> row(result_.modes.size());
+    for (std::size_t m = 0; m < result_.modes.size(); ++m) {
+        const ModeSpec& spec = result_.modes[m];
+        engine_.setQueryParams(spec.queries);
+        recorder_.clear();
+        row[m].stats = spec.oracle ? engine_.renderParts(oracleParts_) : engine_.renderFrame(*schedulers_[m]);
+        row[m].parts = compareParts(truth_, recorder_.drawn());
+        images_[m] = engine_.renderer().readPixels();
+        auto diff = compareImages(images_[m], images_[0]);
+        if (!diff) {
+            engine_.setPartObserver(nullptr);
+            return Error{diff.error().message};
+        }
+        row[m].image = *diff;
+    }
+    engine_.setPartObserver(nullptr);
+    result_.truth.push_back(ft);
+    result_.frames.push_back(std::move(row));
+    return {};
+}
+
+}  // namespace dyncull::cli
+
+namespace dyncull::cli {
+
+Status runMeasurement(const MeasureOptions& o, std::vector<ModeSpec> modes, const std::string& command,
+                      std::vector<ModeSummary>* summaryOut) {
+    if (o.size.x < 1 || o.size.y < 1) return Error{"--size: width and height must be at least 1"};
+    if (o.frames == 0) return Error{"--frames: must be at least 1"};
+    auto made = makeScene(o.scene, o.sceneOptions);
+    if (!made) return Error{made.error().message};
+    DemoScene& scene = **made;
+    const std::filesystem::path dir = o.out.empty() ? "out/measure_" + scene.name() : o.out;
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec) return Error{dir.string() + ": cannot create directory (" + ec.message() + ")"};
+
+    ContextOptions co;
+    co.width = o.size.x;
+    co.height = o.size.y;
+    auto context = GlContext::create(co);
+    if (!context) return Error{context.error().message};
+    auto engineOr = Engine::create(**context);
+    if (!engineOr) return Error{engineOr.error().message};
+    Engine& engine = **engineOr;
+    if (Status s = scene.populate(engine); !s) return s;
+    std::printf("%s\n", scene.description().c_str());
+    std::printf("context: %s, %s; set-up %.0f ms\n", (*context)->platformName().c_str(),
+                (*context)->rendererName().c_str(), scene.setupMs());
+
+    auto runner = BenchRunner::create(engine, scene, std::move(modes));
+    if (!runner) return Error{runner.error().message};
+    std::string names;
+    for (const ModeSpec& m : (*runner)->result().modes) names += (names.empty() ? "" : ",") + m.name;
+    std::printf("modes (interleaved per frame, vfc first): %s\n", names.c_str());
+    std::fflush(stdout);
+    for (std::uint64_t f = 0; f < o.frames; ++f) {
+        if (Status s = (*runner)->runFrame(f); !s) return s;
+        if (!o.quiet && ((f + 1) % 10 == 0 || f + 1 == o.frames)) {
+            std::fprintf(stderr, "frame %llu/%llu\n", static_cast<unsigned long long>(f + 1),
+                         static_cast<unsigned long long>(o.frames));
+        }
+    }
+    if ((*context)->checkErrors() != 0)
+        std::fprintf(stderr, "warning: %llu GL errors\n", static_cast<unsigned long long>((*context)->glErrorCount()));
+
+    const BenchResult& result = (*runner)->result();
+    const std::vector<ModeSummary> summary = summarise(result);
+    if (Status s = writeFramesCsv(result, dir / "frames.csv"); !s) return s;
+    if (Status s = writeSummaryCsv(summary, dir / "summary.csv"); !s) return s;
+    for (std::size_t m = 0; m < result.modes.size(); ++m) {
+        const std::filesystem::path png = dir / ("last_" + result.modes[m].name + ".png");
+        if (Status s = writePng((*runner)->lastImages()[m], png); !s) return s;
+    }
+    const PlotOutcome plots = writePlots(result, summary, dir);
+    if (!plots.message.empty()) std::printf("%s\n", plots.message.c_str());
+    if (Status s = writeReport(result, summary, command, plots.pngs, dir / "report.md"); !s) return s;
+    std::printf("wrote %s, %s, %s", (dir / "frames.csv").c_str(), (dir / "summary.csv").c_str(),
+                (dir / "report.md").c_str());
+    for (const std::string& p : plots.pngs) std::printf(", %s", (dir / p).c_str());
+    std::printf("\n");
+    std::printf("%-16s %9s %8s %8s %9s %9s %10s %6s\n", "mode", "ms/frame", "vs vfc", "parts", "queries", "%px wrong",
+                "false neg", "t/o");
+    for (const ModeSummary& s : summary)
+        std::printf("%-16s %9.2f %8.2f %8.1f %9.1f %9.4f %10llu %6llu\n", s.name.c_str(), s.msMean, s.ratioVfc, s.parts,
+                    s.queries, s.pctWrongMean, static_cast<unsigned long long>(s.falseNegatives),
+                    static_cast<unsigned long long>(s.timeouts));
+    if (summaryOut) *summaryOut = summary;
+    return {};
+}
+
+}  // namespace dyncull::cli

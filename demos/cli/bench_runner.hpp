@@ -1,0 +1,122 @@
+// Runs several culling configurations ("modes") interleaved over the same frames of one
+// scene and measures each against the truth: the scene is moved once per frame, the exact
+// visible set is computed by an ID pass (untimed), then every mode renders that frame with
+// its own QueryScheduler (own visibility history), vfc first so its image is the
+// reference. Shared by `dyncull bench` and `dyncull sweep` (and the conservative test).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "dyncull/demos/demo_scene.hpp"
+#include "dyncull/engine/engine.hpp"
+#include "dyncull/engine/ground_truth.hpp"
+#include "dyncull/engine/image.hpp"
+#include "dyncull/engine/image_compare.hpp"
+#include "dyncull/objects/error.hpp"
+#include "dyncull/scheduler/query_scheduler.hpp"
+
+namespace dyncull::cli {
+
+/// One configuration to measure: a scheduler set-up and the query backend's parameters
+/// (those live in the shared GlQueryBackend, so they are set before the mode renders), or
+/// the oracle, which draws exactly the visible set with no queries (the lower bound).
+struct ModeSpec {
+    std::string name;
+    bool oracle = false;
+    SchedulerParams scheduler;
+    GlQueryParams queries;
+};
+
+/// A named mode: vfc, simple, full, oracle; approximate presets thrN (pixel threshold N),
+/// latency1 (last frame's results), skipN (history: max skip N, 2 frames per visible
+/// answer), overlap (overlapping batches), smallN (small-feature culling below N pixels);
+/// ablations full-nohist, full-nobatch, full-noocc, full-notight. Error names the mode.
+Expected<ModeSpec> modeFromName(const std::string& name);
+/// A comma-separated list of names, e.g. "vfc,simple,full,oracle,thr16".
+Expected<std::vector<ModeSpec>> modesFromList(const std::string& list);
+/// Names understood by modeFromName (N stands for a number), for help texts.
+std::string modeNamesHelp();
+
+/// Sweep of one parameter of `full`: "NAME=v1,v2,..." with NAME one of pixel-threshold,
+/// max-skip, skip-per-visible, small-feature, max-in-flight, tile-size. One mode per value,
+/// named "NAME=v". Error names the bad parameter or value.
+Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec);
+std::string sweepParamsHelp();
+
+/// What one mode did in one frame.
+struct ModeFrame {
+    FrameStats stats;
+    PartErrors parts;   ///< against the ground-truth visible set
+    ImageDiff image;    ///< against the vfc image of the same frame
+};
+
+/// Per-frame facts independent of the mode.
+struct FrameTruth {
+    std::uint32_t visibleParts = 0;   ///< parts with at least one visible pixel
+    std::uint32_t frustumParts = 0;   ///< parts not outside the frustum
+    std::uint64_t coveredPixels = 0;  ///< pixels showing any part
+    double groundTruthMs = 0.0;       ///< ID pass (not counted in any mode's time)
+    double updateMs = 0.0;            ///< loose-BSP relink, once per frame for all modes
+};
+
+struct BenchResult {
+    std::string scene;
+    std::string description;
+    std::string renderer;  ///< GL renderer string
+    int width = 0, height = 0;
+    std::vector<ModeSpec> modes;  ///< modes[0] is vfc (the reference image)
+    std::vector<FrameTruth> truth;                ///< per frame
+    std::vector<std::vector<ModeFrame>> frames;   ///< frames[frame][mode]
+};
+
+/// Borrows the engine (already populated with `scene`) and the scene for its lifetime.
+class BenchRunner {
+public:
+    /// Puts a vfc mode first (adding one if `modes` has none) and validates every mode.
+    static Expected<std::unique_ptr<BenchRunner>> create(Engine& engine, DemoScene& scene, std::vector<ModeSpec> modes);
+
+    /// Moves the scene to `frame`, computes the truth and renders every mode; appends to result().
+    Status runFrame(std::uint64_t frame);
+
+    const BenchResult& result() const { return result_; }
+    /// Image each mode rendered in the last frame (index as result().modes).
+    const std::vector<Image>& lastImages() const { return images_; }
+    const VisibleSet& lastTruth() const { return truth_; }
+
+private:
+    BenchRunner(Engine& engine, DemoScene& scene) : engine_(engine), scene_(scene) {}
+
+    Engine& engine_;
+    DemoScene& scene_;
+    std::unique_ptr<GroundTruth> groundTruth_;
+    std::vector<std::unique_ptr<QueryScheduler>> schedulers_;  // per mode; null for the oracle
+    DrawnPartRecorder recorder_;
+    BenchResult result_;
+    VisibleSet truth_;
+    std::vector<Image> images_;
+    std::vector<NodeRef> oracleParts_;
+};
+
+/// What `dyncull bench` and `dyncull sweep` share: scene, frames, size, output directory.
+struct MeasureOptions {
+    std::string scene = "bunnies";
+    std::uint64_t frames = 60;
+    glm::ivec2 size{640, 360};  ///< framebuffer, pixels
+    std::string out;  ///< output directory; empty: out/measure_<scene>
+    SceneOptions sceneOptions;
+    bool quiet = false;  ///< no progress lines on stderr
+};
+
+/// Creates a headless context and engine, populates the scene, runs `modes` interleaved
+/// for options.frames frames, and writes frames.csv, summary.csv, report.md, the plots and
+/// last_<mode>.png into the output directory, printing what was written. `command` is
+/// quoted at the top of the report. Returns the summary (ModeSummary in report_writer.hpp)
+/// through `summary` when given. Errors name the option or file.
+struct ModeSummary;
+Status runMeasurement(const MeasureOptions& options, std::vector<ModeSpec> modes, const std::string& command,
+                      std::vector<ModeSummary>* summary = nullptr);
+
+}  // namespace dyncull::cli

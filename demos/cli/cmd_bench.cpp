@@ -1,0 +1,73 @@
+// `dyncull bench SCENE --modes vfc,simple,full,oracle,...`: the speed-accuracy table of
+// several culling modes and approximate settings, run interleaved over the same frames,
+// with errors measured against an exact ID-pass ground truth and the vfc image.
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "bench_runner.hpp"
+#include "cli_util.hpp"
+#include "commands.hpp"
+#include "report_writer.hpp"
+#include "scene_options.hpp"
+
+namespace dyncull::cli {
+namespace {
+
+struct BenchOptions {
+    MeasureOptions measure;
+    std::string modes = "vfc,simple,full,oracle";
+    std::string size = "640x360";
+};
+
+std::string ratioText(const std::vector<ModeSummary>& s, const std::string& a, const std::string& b) {
+    const int ia = findMode(s, a), ib = findMode(s, b);
+    if (ia < 0 || ib < 0 || s[ib].msMean <= 0) return "n/a";
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3f", s[ia].msMean / s[ib].msMean);
+    return buf;
+}
+
+void runBench(BenchOptions o) {
+    auto size = parseSize(o.size, "--size");
+    if (!size) fail(size.error().message);
+    o.measure.size = *size;
+    auto modes = modesFromList(o.modes);
+    if (!modes) fail(modes.error().message);
+    if (o.measure.out.empty()) o.measure.out = "out/bench_" + o.measure.scene;
+    const std::string command = "dyncull bench " + o.measure.scene + " --modes " + o.modes + " --frames " +
+                                std::to_string(o.measure.frames) + " --size " + o.size + " --out " + o.measure.out;
+    std::vector<ModeSummary> summary;
+    if (Status s = runMeasurement(o.measure, modes.take(), command, &summary); !s) fail(s.message());
+    std::printf("ratio full/vfc=%s\n", ratioText(summary, "full", "vfc").c_str());
+    std::printf("ratio full/simple=%s\n", ratioText(summary, "full", "simple").c_str());
+    std::printf("ratio full/oracle=%s\n", ratioText(summary, "full", "oracle").c_str());
+    const int full = findMode(summary, "full");
+    if (full >= 0) {
+        std::printf("error full pixels=%.4f%%\n", summary[full].pctWrongMean);
+        std::printf("false_negatives full=%llu\n", static_cast<unsigned long long>(summary[full].falseNegatives));
+    } else {
+        std::printf("error full pixels=n/a\n");
+        std::printf("false_negatives full=n/a\n");
+    }
+}
+
+}  // namespace
+
+void registerBench(CLI::App& app) {
+    auto o = std::make_shared<BenchOptions>();
+    CLI::App* cmd = app.add_subcommand(
+        "bench", "Measure culling modes and approximate settings interleaved: time, parts, queries, error vs ground truth");
+    cmd->add_option("scene", o->measure.scene, "bunnies, powerplant, city, a directory of .ply/.obj parts, or a model file")
+        ->capture_default_str();
+    cmd->add_option("--modes", o->modes, "comma-separated modes: " + modeNamesHelp())->capture_default_str();
+    cmd->add_option("--frames", o->measure.frames, "frames to run")->capture_default_str();
+    cmd->add_option("--size", o->size, "framebuffer size WxH")->capture_default_str();
+    cmd->add_option("--out", o->measure.out, "output directory (default out/bench_<scene>)");
+    cmd->add_flag("--quiet", o->measure.quiet, "no progress lines");
+    addBunnyOptions(*cmd, o->measure.sceneOptions.bunny);
+    addGeneratedSceneOptions(*cmd, o->measure.sceneOptions);
+    cmd->callback([o] { runBench(*o); });
+}
+
+}  // namespace dyncull::cli

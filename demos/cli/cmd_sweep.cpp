@@ -1,0 +1,65 @@
+// `dyncull sweep SCENE --param NAME=v1,v2,...`: the speed-accuracy curve of `full` across
+// one parameter; each value is a mode, run interleaved with vfc (the reference image) and
+// the oracle (the lower bound), with the same outputs as `dyncull bench`.
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "bench_runner.hpp"
+#include "cli_util.hpp"
+#include "commands.hpp"
+#include "report_writer.hpp"
+#include "scene_options.hpp"
+
+namespace dyncull::cli {
+namespace {
+
+struct SweepOptions {
+    MeasureOptions measure;
+    std::string param;
+    std::string size = "640x360";
+};
+
+void runSweep(SweepOptions o) {
+    auto size = parseSize(o.size, "--size");
+    if (!size) fail(size.error().message);
+    o.measure.size = *size;
+    auto values = sweepModes(o.param);
+    if (!values) fail(values.error().message);
+    std::vector<ModeSpec> modes;
+    for (const char* name : {"vfc", "oracle"}) {
+        auto m = modeFromName(name);
+        modes.push_back(m.take());
+    }
+    for (ModeSpec& m : *values) modes.push_back(std::move(m));
+    if (o.measure.out.empty()) o.measure.out = "out/sweep_" + o.measure.scene;
+    const std::string command = "dyncull sweep " + o.measure.scene + " --param " + o.param + " --frames " +
+                                std::to_string(o.measure.frames) + " --size " + o.size + " --out " + o.measure.out;
+    std::vector<ModeSummary> summary;
+    if (Status s = runMeasurement(o.measure, std::move(modes), command, &summary); !s) fail(s.message());
+    for (const ModeSummary& s : summary) {
+        if (s.name == "vfc" || s.oracle) continue;
+        std::printf("sweep %s ms=%.3f ratio_vfc=%.3f ratio_oracle=%.3f pixels=%.4f%% false_negatives=%llu\n",
+                    s.name.c_str(), s.msMean, s.ratioVfc, s.ratioOracle, s.pctWrongMean,
+                    static_cast<unsigned long long>(s.falseNegatives));
+    }
+}
+
+}  // namespace
+
+void registerSweep(CLI::App& app) {
+    auto o = std::make_shared<SweepOptions>();
+    CLI::App* cmd = app.add_subcommand("sweep", "Speed-accuracy curve of full across one parameter (with vfc and oracle)");
+    cmd->add_option("scene", o->measure.scene, "bunnies, powerplant, city, a directory of .ply/.obj parts, or a model file")
+        ->capture_default_str();
+    cmd->add_option("--param", o->param, "NAME=v1,v2,... with NAME one of " + sweepParamsHelp())->required();
+    cmd->add_option("--frames", o->measure.frames, "frames to run")->capture_default_str();
+    cmd->add_option("--size", o->size, "framebuffer size WxH")->capture_default_str();
+    cmd->add_option("--out", o->measure.out, "output directory (default out/sweep_<scene>)");
+    cmd->add_flag("--quiet", o->measure.quiet, "no progress lines");
+    addBunnyOptions(*cmd, o->measure.sceneOptions.bunny);
+    addGeneratedSceneOptions(*cmd, o->measure.sceneOptions);
+    cmd->callback([o] { runSweep(*o); });
+}
+
+}  // namespace dyncull::cli

@@ -1,0 +1,307 @@
+// CSV, Markdown and gnuplot outputs of bench and sweep (see report_writer.hpp).
+#include "report_writer.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+namespace dyncull::cli {
+namespace fs = std::filesystem;
+namespace {
+
+std::string fmt(double v, int decimals) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+    return buf;
+}
+
+/// Single-quoted gnuplot string (backslashes are literal inside single quotes; a quote is doubled).
+std::string gpQuote(const std::string& s) {
+    std::string out = "'";
+    for (char c : s) {
+        if (c == '\'') out += "''";
+        else out += c;
+    }
+    return out + "'";
+}
+
+std::string shellQuote(const std::string& s) {
+    std::string out = "'";
+    for (char c : s) {
+        if (c == '\'') out += "'\\''";
+        else out += c;
+    }
+    return out + "'";
+}
+
+/// First executable `name` on $PATH, or empty.
+std::string findOnPath(const std::string& name) {
+    const char* path = std::getenv("PATH");
+    if (!path) return {};
+    std::stringstream ss(path);
+    std::string dir;
+    while (std::getline(ss, dir, ':')) {
+        if (dir.empty()) continue;
+        const fs::path p = fs::path(dir) / name;
+        std::error_code ec;
+        const auto st = fs::status(p, ec);
+        if (!ec && fs::is_regular_file(st) && (st.permissions() & fs::perms::others_exec) != fs::perms::none)
+            return p.string();
+    }
+    return {};
+}
+
+Status openFor(std::ofstream& f, const fs::path& path) {
+    f.open(path);
+    if (!f) return Error{path.string() + ": cannot write"};
+    return {};
+}
+
+}  // namespace
+
+int findMode(const std::vector<ModeSummary>& summary, const std::string& name) {
+    for (std::size_t i = 0; i < summary.size(); ++i)
+        if (summary[i].name == name) return static_cast<int>(i);
+    return -1;
+}
+
+std::vector<ModeSummary> summarise(const BenchResult& r) {
+    std::vector<ModeSummary> out(r.modes.size());
+    for (std::size_t m = 0; m < r.modes.size(); ++m) {
+        ModeSummary& s = out[m];
+        s.name = r.modes[m].name;
+        s.oracle = r.modes[m].oracle;
+        s.frames = r.frames.size();
+        std::vector<double> ms;
+        for (const auto& row : r.frames) {
+            const ModeFrame& f = row[m];
+            ms.push_back(f.stats.frameMs);
+            s.traversalMs += f.stats.traversalMs;
+            s.waitMs += f.stats.waitMs;
+            s.drawMs += f.stats.drawMs;
+            s.parts += f.stats.partsDrawn;
+            s.triangles += static_cast<double>(f.stats.trianglesDrawn);
+            s.queries += f.stats.queriesIssued;
+            s.occluded += f.stats.queriesOccluded;
+            s.skippedHistory += f.stats.skippedByHistory;
+            s.skippedOccupancy += f.stats.skippedByOccupancy;
+            s.batches += f.stats.batches;
+            s.pctWrongMean += f.image.percentDiffering;
+            s.pctWrongMax = std::max(s.pctWrongMax, f.image.percentDiffering);
+            if (f.image.differingPixels) ++s.framesWrong;
+            s.falseNegatives += f.parts.falseNegatives;
+            s.falseNegativePixels += f.parts.falseNegativePixels;
+            s.falsePositives += f.parts.falsePositives;
+            s.largestRegion = std::max(s.largestRegion, f.image.largestRegion);
+            s.timeouts += f.stats.queriesTimedOut;
+        }
+        if (ms.empty()) continue;
+        const double n = static_cast<double>(ms.size());
+        for (double v : ms) s.msMean += v;
+        s.msMean /= n;
+        for (double* v : {&s.traversalMs, &s.waitMs, &s.drawMs, &s.parts, &s.triangles, &s.queries, &s.occluded,
+                          &s.skippedHistory, &s.skippedOccupancy, &s.batches, &s.pctWrongMean, &s.falsePositives})
+            *v /= n;
+        std::sort(ms.begin(), ms.end());
+        s.msMin = ms.front();
+        s.msMax = ms.back();
+        s.msMedian = ms.size() % 2 ? ms[ms.size() / 2] : 0.5 * (ms[ms.size() / 2 - 1] + ms[ms.size() / 2]);
+    }
+    const int vfc = findMode(out, "vfc");
+    int oracle = -1;
+    for (std::size_t i = 0; i < out.size(); ++i)
+        if (out[i].oracle) oracle = static_cast<int>(i);
+    for (ModeSummary& s : out) {
+        if (vfc >= 0 && out[vfc].msMean > 0) s.ratioVfc = s.msMean / out[vfc].msMean;
+        if (oracle >= 0 && out[oracle].msMean > 0) s.ratioOracle = s.msMean / out[oracle].msMean;
+    }
+    // Pareto front over (mean ms, mean % pixels wrong) among real modes: a mode is on it
+    // unless another is no slower and no less accurate, and strictly better in one.
+    for (ModeSummary& a : out) {
+        if (a.oracle) continue;
+        a.pareto = std::none_of(out.begin(), out.end(), [&](const ModeSummary& b) {
+            return !b.oracle && &b != &a && b.msMean <= a.msMean && b.pctWrongMean <= a.pctWrongMean &&
+                   (b.msMean < a.msMean || b.pctWrongMean < a.pctWrongMean);
+        });
+    }
+    return out;
+}
+
+Status writeFramesCsv(const BenchResult& r, const fs::path& path) {
+    std::ofstream f;
+    if (Status s = openFor(f, path); !s) return s;
+    f << "frame,mode,ms_frame,ms_traversal,ms_wait,ms_draw,ms_update,queries,queries_occluded,queries_timed_out,"
+         "skipped_history,skipped_occupancy,visible_near,frustum_culled,small_feature_culled,nodes_visited,batches,"
+         "parts,triangles,visible_parts,frustum_parts,false_negatives,false_negative_pixels,false_positives,"
+         "pixels_wrong,pixels_wrong_pct,largest_wrong_region,frame_update_ms,ground_truth_ms\n";
+    for (std::size_t i = 0; i < r.frames.size(); ++i) {
+        const FrameTruth& t = r.truth[i];
+        for (std::size_t m = 0; m < r.modes.size(); ++m) {
+            const FrameStats& s = r.frames[i][m].stats;
+            const PartErrors& p = r.frames[i][m].parts;
+            const ImageDiff& d = r.frames[i][m].image;
+            f << i << ',' << r.modes[m].name << ',' << s.frameMs << ',' << s.traversalMs << ',' << s.waitMs << ','
+              << s.drawMs << ',' << s.updateMs << ',' << s.queriesIssued << ',' << s.queriesOccluded << ','
+              << s.queriesTimedOut << ',' << s.skippedByHistory << ',' << s.skippedByOccupancy << ','
+              << s.visibleNearOrInside << ',' << s.frustumCulled << ',' << s.smallFeatureCulled << ','
+              << s.nodesVisited << ',' << s.batches << ',' << s.partsDrawn << ',' << s.trianglesDrawn << ','
+              << t.visibleParts << ',' << t.frustumParts << ',' << p.falseNegatives << ',' << p.falseNegativePixels
+              << ',' << p.falsePositives << ',' << d.differingPixels << ',' << d.percentDiffering << ','
+              << d.largestRegion << ',' << t.updateMs << ',' << t.groundTruthMs << '\n';
+        }
+    }
+    if (!f) return Error{path.string() + ": write failed"};
+    return {};
+}
+
+Status writeSummaryCsv(const std::vector<ModeSummary>& summary, const fs::path& path) {
+    std::ofstream f;
+    if (Status s = openFor(f, path); !s) return s;
+    f << "mode,frames,ms_mean,ms_median,ms_min,ms_max,ms_traversal,ms_wait,ms_draw,ratio_vfc,ratio_oracle,parts,"
+         "triangles,queries,queries_occluded,skipped_history,skipped_occupancy,batches,pixels_wrong_pct_mean,"
+         "pixels_wrong_pct_max,frames_wrong,false_negatives,false_negative_pixels,false_positives_per_frame,"
+         "largest_wrong_region,timeouts,pareto\n";
+    for (const ModeSummary& s : summary)
+        f << s.name << ',' << s.frames << ',' << s.msMean << ',' << s.msMedian << ',' << s.msMin << ',' << s.msMax
+          << ',' << s.traversalMs << ',' << s.waitMs << ',' << s.drawMs << ',' << s.ratioVfc << ',' << s.ratioOracle
+          << ',' << s.parts << ',' << s.triangles << ',' << s.queries << ',' << s.occluded << ',' << s.skippedHistory
+          << ',' << s.skippedOccupancy << ',' << s.batches << ',' << s.pctWrongMean << ',' << s.pctWrongMax << ','
+          << s.framesWrong << ',' << s.falseNegatives << ',' << s.falseNegativePixels << ',' << s.falsePositives
+          << ',' << s.largestRegion << ',' << s.timeouts << ',' << (s.pareto ? 1 : 0) << '\n';
+    if (!f) return Error{path.string() + ": write failed"};
+    return {};
+}
+
+PlotOutcome writePlots(const BenchResult& r, const std::vector<ModeSummary>& summary, const fs::path& dir) {
+    PlotOutcome out;
+    const std::string gnuplot = findOnPath("gnuplot");
+    if (gnuplot.empty()) {
+        out.message = "gnuplot not found, plots skipped";
+        return out;
+    }
+    out.gnuplotFound = true;
+    // Wide per-frame table: frame, then ms, parts, queries of each mode in turn.
+    {
+        std::ofstream f(dir / "plot_frames.dat");
+        f << "# frame";
+        for (const ModeSpec& m : r.modes) f << ' ' << m.name << "_ms " << m.name << "_parts " << m.name << "_queries";
+        f << '\n';
+        for (std::size_t i = 0; i < r.frames.size(); ++i) {
+            f << i;
+            for (const ModeFrame& mf : r.frames[i])
+                f << ' ' << mf.stats.frameMs << ' ' << mf.stats.partsDrawn << ' ' << mf.stats.queriesIssued;
+            f << '\n';
+        }
+        if (!f) {
+            out.message = "cannot write plot data in " + dir.string() + ", plots skipped";
+            return out;
+        }
+    }
+    {
+        std::ofstream f(dir / "plot_pareto.dat");
+        f << "# mode ms_mean pixels_wrong_pct_mean pareto\n";
+        for (const ModeSummary& s : summary)
+            f << '"' << s.name << "\" " << s.msMean << ' ' << s.pctWrongMean << ' ' << (s.pareto ? 1 : 0) << '\n';
+        std::ofstream front(dir / "plot_front.dat");
+        std::vector<const ModeSummary*> pts;
+        for (const ModeSummary& s : summary)
+            if (s.pareto) pts.push_back(&s);
+        std::sort(pts.begin(), pts.end(), [](auto* a, auto* b) { return a->msMean < b->msMean; });
+        front << "# ms_mean pixels_wrong_pct_mean (Pareto front, by time)\n";
+        for (auto* s : pts) front << s->msMean << ' ' << s->pctWrongMean << '\n';
+    }
+    std::string names;
+    for (const ModeSpec& m : r.modes) names += (names.empty() ? "" : " ") + m.name;
+    const std::string title = r.scene + ", " + std::to_string(r.width) + "x" + std::to_string(r.height) + ", " +
+                              std::to_string(r.frames.size()) + " frames";
+    std::ofstream gp(dir / "plots.gp");
+    gp << "# gnuplot script written by dyncull bench/sweep; run it in this directory.\n"
+       << "if (strstrt(GPVAL_TERMINALS, 'pngcairo') > 0) {\n"
+       << "  set terminal pngcairo size 1100,620 noenhanced font 'sans,10'\n"
+       << "} else {\n"
+       << "  set terminal png size 1100,620 noenhanced\n"
+       << "}\n"
+       << "names = " << gpQuote(names) << "\n"
+       << "n = words(names)\n"
+       << "data = " << gpQuote((dir / "plot_frames.dat").string()) << "\n"
+       << "set grid\nset key outside right top\nset xlabel 'frame'\n"
+       << "set output " << gpQuote((dir / "time_per_frame.png").string()) << "\n"
+       << "set title " << gpQuote("Time per frame (" + title + ")") << "\nset ylabel 'ms'\n"
+       << "plot for [i=1:n] data using 1:(column(2 + 3*(i-1))) with lines lw 1.5 title word(names, i)\n"
+       << "set output " << gpQuote((dir / "parts_per_frame.png").string()) << "\n"
+       << "set title " << gpQuote("Object parts drawn per frame (" + title + ")") << "\nset ylabel 'parts'\n"
+       << "plot for [i=1:n] data using 1:(column(3 + 3*(i-1))) with lines lw 1.5 title word(names, i)\n"
+       << "set output " << gpQuote((dir / "queries_per_frame.png").string()) << "\n"
+       << "set title " << gpQuote("Occlusion queries per frame (" + title + ")") << "\nset ylabel 'queries'\n"
+       << "plot for [i=1:n] data using 1:(column(4 + 3*(i-1))) with lines lw 1.5 title word(names, i)\n"
+       << "set output " << gpQuote((dir / "speed_vs_accuracy.png").string()) << "\n"
+       << "set title " << gpQuote("Speed vs accuracy (" + title + "); oracle = lower bound, not on the front")
+       << "\nset xlabel 'mean ms per frame'\nset ylabel 'mean % pixels unlike vfc'\n"
+       << "set offsets graph 0.08, graph 0.15, graph 0.1, graph 0.1\n"
+       << "plot " << gpQuote((dir / "plot_front.dat").string())
+       << " using 1:2 with linespoints lw 2 pt 7 ps 1.6 lc rgb '#d62728' title 'Pareto front', \\\n"
+       << "     " << gpQuote((dir / "plot_pareto.dat").string())
+       << " using 2:3 with points pt 6 ps 1.4 lc rgb '#1f77b4' title 'mode / setting', \\\n"
+       << "     '' using 2:3:1 with labels left offset 0.8,0.6 notitle\n";
+    gp.close();
+    const fs::path log = dir / "gnuplot.log";
+    const std::string cmd = shellQuote(gnuplot) + " " + shellQuote((dir / "plots.gp").string()) + " > " +
+                            shellQuote(log.string()) + " 2>&1";
+    const int rc = std::system(cmd.c_str());
+    for (const char* png : {"time_per_frame.png", "parts_per_frame.png", "queries_per_frame.png", "speed_vs_accuracy.png"}) {
+        std::error_code ec;
+        if (fs::exists(dir / png, ec) && fs::file_size(dir / png, ec) > 0) out.pngs.push_back(png);
+    }
+    if (rc != 0) out.message = "gnuplot failed (see " + log.string() + ")";
+    return out;
+}
+
+Status writeReport(const BenchResult& r, const std::vector<ModeSummary>& summary, const std::string& command,
+                   const std::vector<std::string>& plots, const fs::path& path) {
+    std::ofstream f;
+    if (Status s = openFor(f, path); !s) return s;
+    double visible = 0, frustum = 0, gtMs = 0, updateMs = 0;
+    for (const FrameTruth& t : r.truth) {
+        visible += t.visibleParts;
+        frustum += t.frustumParts;
+        gtMs += t.groundTruthMs;
+        updateMs += t.updateMs;
+    }
+    const double n = std::max<double>(1.0, static_cast<double>(r.truth.size()));
+    f << "# dyncull measurement: " << r.scene << "\n\n"
+      << "`" << command << "`\n\n"
+      << "- scene: " << r.description << "\n"
+      << "- renderer: " << r.renderer << ", " << r.width << "x" << r.height << ", " << r.truth.size() << " frames\n"
+      << "- ground truth (ID pass): " << fmt(visible / n, 1) << " visible parts per frame of " << fmt(frustum / n, 1)
+      << " in the frustum; " << fmt(gtMs / n, 1) << " ms per frame, not counted in any mode\n"
+      << "- loose-BSP relink: " << fmt(updateMs / n, 2) << " ms per frame, done once per frame before the modes "
+      << "(not counted in any mode)\n"
+      << "- modes run interleaved: per frame the scene moves once, then every mode renders that frame with its own "
+         "scheduler and history, vfc first (its image is the reference)\n\n";
+    f << "| mode | ms/frame | median | vs vfc | vs oracle | parts drawn | triangles | queries | occluded | wait ms |"
+         " % px wrong (mean) | % px wrong (max) | frames wrong | false neg. (parts) | false neg. (px) |"
+         " false pos./frame | largest wrong region (px) | timeouts |\n"
+      << "|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|\n";
+    for (const ModeSummary& s : summary)
+        f << "| " << s.name << (s.pareto ? " *" : "") << " | " << fmt(s.msMean, 2) << " | " << fmt(s.msMedian, 2)
+          << " | " << fmt(s.ratioVfc, 2) << " | " << fmt(s.ratioOracle, 2) << " | " << fmt(s.parts, 1) << " | "
+          << fmt(s.triangles, 0) << " | " << fmt(s.queries, 1) << " | " << fmt(s.occluded, 1) << " | "
+          << fmt(s.waitMs, 2) << " | " << fmt(s.pctWrongMean, 4) << " | " << fmt(s.pctWrongMax, 4) << " | "
+          << s.framesWrong << " | " << s.falseNegatives << " | " << s.falseNegativePixels << " | "
+          << fmt(s.falsePositives, 1) << " | " << s.largestRegion << " | " << s.timeouts << " |\n";
+    f << "\nColumns: means per frame unless noted; *vs vfc* and *vs oracle* are mean ms divided by that mode's; "
+         "*% px wrong* compares the frame exactly (RGBA) with the vfc frame; false negatives are visible parts "
+         "(ground truth) not drawn, summed over frames, with the pixels they own; false positives are drawn parts "
+         "with no visible pixel; the largest wrong region is the biggest 4-connected blob of wrong pixels in any "
+         "frame. `*` marks modes on the speed-accuracy Pareto front (the oracle is a bound, not a mode).\n";
+    if (!plots.empty()) {
+        f << "\n## Plots\n\n";
+        for (const std::string& p : plots) f << "![" << p << "](" << p << ")\n\n";
+    }
+    if (!f) return Error{path.string() + ": write failed"};
+    return {};
+}
+
+}  // namespace dyncull::cli

@@ -1,0 +1,59 @@
+// Outputs of `dyncull bench` and `dyncull sweep`: per-frame CSV (frame x mode), per-mode
+// summary CSV, a Markdown report with a table in the style of the two-level paper's
+// Table 1 (time, parts, queries, ratios to vfc and to the oracle, error columns), and PNG
+// plots drawn by gnuplot when it is installed (time, parts and queries per frame, as the
+// paper's Figures 6-9, and speed against accuracy with the Pareto front).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "bench_runner.hpp"
+#include "dyncull/objects/error.hpp"
+
+namespace dyncull::cli {
+
+/// Per-mode aggregates over all frames (means are per frame).
+struct ModeSummary {
+    std::string name;
+    bool oracle = false;
+    std::size_t frames = 0;
+    double msMean = 0, msMedian = 0, msMin = 0, msMax = 0;
+    double traversalMs = 0, waitMs = 0, drawMs = 0;
+    double parts = 0, triangles = 0, queries = 0, occluded = 0, skippedHistory = 0, skippedOccupancy = 0, batches = 0;
+    double pctWrongMean = 0, pctWrongMax = 0;
+    std::uint32_t framesWrong = 0;            ///< frames with at least one pixel unlike vfc
+    std::uint64_t falseNegatives = 0;         ///< summed over frames
+    std::uint64_t falseNegativePixels = 0;    ///< summed over frames
+    double falsePositives = 0;                ///< per frame
+    std::uint64_t largestRegion = 0;          ///< largest wrong region of any frame, pixels
+    std::uint64_t timeouts = 0;               ///< queries that never answered, summed
+    double ratioVfc = 0, ratioOracle = 0;     ///< msMean / that mode's msMean (0 if absent)
+    bool pareto = false;  ///< on the speed-accuracy Pareto front (the oracle never is: it is not a real mode)
+};
+
+std::vector<ModeSummary> summarise(const BenchResult& result);
+/// Index of the mode named `name`, or -1.
+int findMode(const std::vector<ModeSummary>& summary, const std::string& name);
+
+/// DIR/frames.csv: one row per frame and mode with every FrameStats field and the errors.
+Status writeFramesCsv(const BenchResult& result, const std::filesystem::path& path);
+/// DIR/summary.csv: one row per mode.
+Status writeSummaryCsv(const std::vector<ModeSummary>& summary, const std::filesystem::path& path);
+
+struct PlotOutcome {
+    bool gnuplotFound = false;
+    std::vector<std::string> pngs;  ///< file names (relative to the output directory)
+    std::string message;            ///< e.g. "gnuplot not found, plots skipped"
+};
+/// Writes the plot data and gnuplot script into `dir` and runs gnuplot if it is on PATH.
+PlotOutcome writePlots(const BenchResult& result, const std::vector<ModeSummary>& summary,
+                       const std::filesystem::path& dir);
+
+/// DIR/report.md. `command` is the command line shown at the top; `plots` the PNGs to embed.
+Status writeReport(const BenchResult& result, const std::vector<ModeSummary>& summary, const std::string& command,
+                   const std::vector<std::string>& plots, const std::filesystem::path& path);
+
+}  // namespace dyncull::cli
