@@ -1,0 +1,143 @@
+// Ground truth by the ID pass on hand-made scenes: hidden parts are not visible, pixel
+// counts add up to the covered pixels, and coverage matches the renderer's own image
+// pixel for pixel. Also the drawn-part recorder and the part comparison.
+#include <gtest/gtest.h>
+
+#include "dyncull/engine/engine.hpp"
+#include "dyncull/engine/ground_truth.hpp"
+#include "engine/gl_test_util.hpp"
+#include "engine/procedural_meshes.hpp"
+
+namespace dyncull {
+namespace {
+
+using test::cameraOnZ;
+using test::headless;
+using test::isClear;
+
+Transform at(const glm::vec3& p) {
+    Transform t;
+    t.translation = p;
+    return t;
+}
+
+struct QuadAndCube : ::testing::Test {
+    std::unique_ptr<GlContext> ctx = headless();
+    std::unique_ptr<Engine> engine;
+    std::unique_ptr<GroundTruth> truth;
+    ObjectHandle quad, cube, faraway;
+
+    void SetUp() override {
+        ASSERT_TRUE(ctx);
+        auto e = Engine::create(*ctx);
+        ASSERT_TRUE(e.ok());
+        engine = e.take();
+        auto g = GroundTruth::create(*ctx);
+        ASSERT_TRUE(g.ok()) << g.error().message;
+        truth = g.take();
+        const ModelId quadModel = *engine->addModel(test::quadMesh(1.0f));
+        const ModelId cubeModel = *engine->addModel(test::cubeMesh(0.4f));
+        quad = *engine->addObject(quadModel, at({0, 0, 0}));
+        cube = *engine->addObject(cubeModel, at({0, 0, -2}));  // right behind the quad
+        faraway = *engine->addObject(cubeModel, at({50, 0, 0}));  // outside the frustum
+        ASSERT_TRUE(engine->setCamera(cameraOnZ(3.0f)).ok());
+        SchedulerParams vfc;
+        vfc.mode = CullMode::Vfc;
+        ASSERT_TRUE(engine->setSchedulerParams(vfc).ok());
+    }
+
+    /// Renders vfc and checks the ID image against it pixel by pixel.
+    void expectCoverageMatchesRender(const VisibleSet& vs) {
+        engine->renderFrame();
+        const Image img = engine->renderer().readPixels();
+        const std::vector<std::uint32_t>& ids = truth->idImage();
+        ASSERT_EQ(ids.size(), static_cast<std::size_t>(img.width) * static_cast<std::size_t>(img.height));
+        std::uint64_t nonClear = 0, mismatched = 0;
+        for (int y = 0; y < img.height; ++y)
+            for (int x = 0; x < img.width; ++x) {
+                const bool covered = ids[static_cast<std::size_t>(y * img.width + x)] != 0;
+                const bool drawn = !isClear(img.at(x, y));
+                nonClear += drawn;
+                mismatched += covered != drawn;
+            }
+        EXPECT_EQ(mismatched, 0u);
+        EXPECT_EQ(nonClear, vs.coveredPixels);
+    }
+};
+
+TEST_F(QuadAndCube, HiddenCubeIsNotVisible) {
+    const VisibleSet vs = truth->compute(*engine, engine->camera());
+    EXPECT_EQ(vs.candidates, 2u);  // the far cube is frustum-culled
+    ASSERT_EQ(vs.parts.size(), 1u);
+    EXPECT_EQ(vs.parts[0], (PartKey{quad.index, 0}));
+    EXPECT_FALSE(vs.contains({cube.index, 0}));
+    EXPECT_EQ(vs.pixelsOf({cube.index, 0}), 0u);
+    EXPECT_EQ(vs.pixels[0], vs.coveredPixels);
+    // Quad of half-size 1 at distance 3, fov 0.9: about 2 / (2 * 3 tan 0.45) of 64 per side.
+    EXPECT_GT(vs.coveredPixels, 1600u);
+    EXPECT_LT(vs.coveredPixels, 2400u);
+    expectCoverageMatchesRender(vs);
+}
+
+TEST_F(QuadAndCube, PartlyHiddenCubeCountsItsOwnPixels) {
+    ASSERT_TRUE(engine->setTransform(cube, at({2.0f, 0, -2})).ok());  // sticks out right of the quad
+    const VisibleSet vs = truth->compute(*engine, engine->camera());
+    ASSERT_EQ(vs.parts.size(), 2u);
+    const std::uint32_t q = vs.pixelsOf({quad.index, 0}), c = vs.pixelsOf({cube.index, 0});
+    EXPECT_GT(q, 0u);
+    EXPECT_GT(c, 0u);
+    EXPECT_EQ(std::uint64_t{q} + c, vs.coveredPixels);
+    expectCoverageMatchesRender(vs);
+}
+
+TEST_F(QuadAndCube, DrawnPartsAreComparedWithTheTruth) {
+    const VisibleSet vs = truth->compute(*engine, engine->camera());
+    DrawnPartRecorder rec;
+    engine->setPartObserver([&](std::uint32_t o, std::uint32_t first, std::uint32_t count) {
+        rec.record(engine->objects(), o, first, count);
+    });
+    engine->renderFrame();  // vfc draws quad and hidden cube
+    engine->setPartObserver(nullptr);
+    const PartErrors e = compareParts(vs, rec.drawn());
+    EXPECT_EQ(e.drawn, 2u);
+    EXPECT_EQ(e.falseNegatives, 0u);
+    EXPECT_EQ(e.falsePositives, 1u);
+    const PartErrors none = compareParts(vs, {});
+    EXPECT_EQ(none.falseNegatives, 1u);
+    EXPECT_EQ(none.falseNegativePixels, vs.coveredPixels);
+    // The oracle path draws exactly the visible set and gives the same picture as vfc.
+    const Image vfcImage = engine->renderer().readPixels();
+    const FrameStats st = engine->renderParts({{quad.index, 0}});
+    EXPECT_EQ(st.partsDrawn, 1u);
+    EXPECT_EQ(engine->renderer().readPixels().rgba, vfcImage.rgba);
+    EXPECT_EQ(ctx->checkErrors(), 0u);
+}
+
+TEST(DrawnPartRecorder, RangesMapToTheLeavesTheyCover) {
+    SceneObjects objects;
+    LocalBspParams p;
+    p.maxLeafTriangles = 40;
+    auto bsp = buildLocalBsp(test::sphereMesh(1.0f, 12, 24), p);
+    ASSERT_TRUE(bsp.ok());
+    const ModelId model = objects.addModel(bsp.take());
+    const ObjectHandle h = *objects.addObject(model, Transform{});
+    const LocalBsp& b = objects.model(model);
+    std::uint32_t leaves = 0, someLeaf = 0;
+    for (std::uint32_t i = 0; i < b.nodes.size(); ++i)
+        if (b.nodes[i].isLeaf() && b.nodes[i].indexCount > 0) {
+            ++leaves;
+            someLeaf = i;
+        }
+    ASSERT_GT(leaves, 4u);
+    DrawnPartRecorder rec;
+    rec.record(objects, h.index, b.nodes[someLeaf].firstIndex, b.nodes[someLeaf].indexCount);
+    ASSERT_EQ(rec.drawn().size(), 1u);
+    EXPECT_EQ(rec.drawn()[0], (PartKey{h.index, someLeaf}));
+    rec.clear();
+    rec.record(objects, h.index, b.root().firstIndex, b.root().indexCount);  // whole subtree
+    rec.record(objects, h.index, b.nodes[someLeaf].firstIndex, b.nodes[someLeaf].indexCount);  // duplicate
+    EXPECT_EQ(rec.drawn().size(), leaves);
+}
+
+}  // namespace
+}  // namespace dyncull
