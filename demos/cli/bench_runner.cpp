@@ -285,10 +285,10 @@ Status runMeasurement(const MeasureOptions& o, std::vector<ModeSpec> modes, cons
                 (dir / "report.md").c_str());
     for (const std::string& p : plots.pngs) std::printf(", %s", (dir / p).c_str());
     std::printf("\n");
-    std::printf("%-16s %9s %8s %8s %9s %9s %10s %6s\n", "mode", "ms/frame", "vs vfc", "parts", "queries", "%px wrong",
+    std::printf("%-20s %9s %8s %8s %9s %9s %10s %6s\n", "mode", "ms/frame", "vs vfc", "parts", "queries", "%px wrong",
                 "false neg", "t/o");
     for (const ModeSummary& s : summary)
-        std::printf("%-16s %9.2f %8.2f %8.1f %9.1f %9.4f %10llu %6llu\n", s.name.c_str(), s.msMean, s.ratioVfc, s.parts,
+        std::printf("%-20s %9.2f %8.2f %8.1f %9.1f %9.4f %10llu %6llu\n", s.name.c_str(), s.msMean, s.ratioVfc, s.parts,
                     s.queries, s.pctWrongMean, static_cast<unsigned long long>(s.falseNegatives),
                     static_cast<unsigned long long>(s.timeouts));
     if (summaryOut) *summaryOut = summary;
