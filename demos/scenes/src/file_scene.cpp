@@ -6,6 +6,7 @@
 #include "dyncull/demos/demo_scene.hpp"
 #include "dyncull/objects/loaders.hpp"
 #include "dyncull/objects/motion.hpp"
+#include "file_camera.hpp"
 
 namespace dyncull {
 namespace {
@@ -35,16 +36,15 @@ public:
             if (!h) return Error{path_ + ": " + h.error().message};
         }
         bounds_ = scene->worldBounds();
-        const glm::vec3 e = bounds_.extent();
-        const float longest = std::max({e.x, e.y, e.z});
-        const float shortest = std::max(std::min({e.x, e.y, e.z}), 1e-6f * longest);
-        // Elongated models (an atrium, a street) are walked through; compact ones orbited.
-        walkthrough_ = longest / shortest > 1.8f;
+        const FileCameraChoice choice = chooseFileCamera(*scene, bounds_);
+        walkthrough_ = choice.walkthrough;
+        const double enclosed = choice.enclosedFraction;
         description_ = path_ + ": " + std::to_string(scene->instances.size()) + " objects, " +
                        std::to_string(scene->meshes.size()) + " meshes, " +
                        std::to_string(scene->instancedTriangleCount()) + " triangles drawn (" +
                        std::to_string(after) + " after local-BSP splitting per mesh); camera: " +
-                       (walkthrough_ ? "walkthrough" : "orbit");
+                       (walkthrough_ ? "walkthrough" : "orbit") + " (" + std::to_string(int(100.0 * enclosed + 0.5)) +
+                       "% of rays from the walk path meet a front face)";
         setupMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         return {};
     }
@@ -57,15 +57,10 @@ public:
         const glm::vec3 e = bounds_.extent();
         const float radius = 0.5f * glm::length(e);
         if (walkthrough_) {
-            // Along the longest horizontal axis at a third of the height, looking ahead.
-            const int axis = e.x >= e.z ? 0 : 2;
-            glm::vec3 a(0.0f), side(0.0f);
-            a[axis] = 0.4f * e[axis];
-            side[2 - axis] = 0.15f * e[2 - axis];
-            const glm::vec3 base = centre + glm::vec3(0.0f, -0.5f * e.y + 0.3f * e.y, 0.0f);
-            const std::vector<glm::vec3> eyes = {base - a, base - 0.3f * a + side, base + 0.3f * a - side, base + a};
-            const std::vector<glm::vec3> targets = {base + 0.2f * a, base + 0.7f * a - side, base + 1.2f * a, base + 2.0f * a + side};
-            CameraPath(eyes, targets, kFrames / 3, false).apply(frame, c);
+            const WalkAxes w = walkAxes(bounds_);
+            const std::vector<glm::vec3> targets = {w.base + 0.2f * w.along, w.base + 0.7f * w.along - w.side,
+                                                    w.base + 1.2f * w.along, w.base + 2.0f * w.along + w.side};
+            CameraPath(walkEyes(bounds_), targets, kFrames / 3, false).apply(frame, c);
             c.nearPlane = 1e-3f * radius;
             c.farPlane = 3.0f * radius;
         } else {
