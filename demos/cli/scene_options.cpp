@@ -6,6 +6,7 @@ void addBunnyOptions(CLI::App& cmd, BunnySwarmOptions& o) {
     cmd.add_option("--count", o.count, "bunnies: number of bunnies")->capture_default_str();
     cmd.add_option("--box", o.box, "bunnies: side of the box they move in (world units)")->capture_default_str();
     cmd.add_option("--bunny-size", o.bunnySize, "bunnies: longest side of one bunny (world units)")->capture_default_str();
+    cmd.add_option("--leaf-tris", o.leafTriangles, "bunnies: local-BSP leaf size in triangles (smaller: finer culling, more queries)")->capture_default_str();
     cmd.add_option("--speed", o.speed, "bunnies: speed in world units per frame")->capture_default_str();
     cmd.add_option("--seed", o.seed, "bunnies: seed of start positions, velocities and orientations")->capture_default_str();
     cmd.add_option("--orbit", o.orbit, "bunnies: orbit the box at this distance instead of the default flight");

@@ -57,7 +57,9 @@ public:
         if (choice->subdivided) mesh = loopSubdivide(mesh, 2);
         normalise(mesh, o_.bunnySize);
         const std::size_t triangles = mesh.triangleCount();
-        auto model = engine.addModel(mesh);
+        LocalBspParams bspParams;
+        bspParams.maxLeafTriangles = o_.leafTriangles;
+        auto model = engine.addModel(mesh, bspParams);
         if (!model) return Error{model.error().message};
         const LocalBsp& bsp = engine.model(*model);
         for (std::uint32_t i = 0; i < o_.count; ++i) {
