@@ -51,40 +51,61 @@ ModeSpec fullMode(const std::string& name) {
 std::string modeNamesHelp() {
     return "vfc, simple, full, oracle; approximate: thrN (pixel threshold), latency1 (last frame's results), "
            "skipN (history max skip N, 2 per visible), overlap (overlapping batches), smallN (small-feature pixels); "
-           "ablations: full-nohist, full-nobatch, full-noocc, full-notight";
+           "ablations: full-nohist, full-nobatch, full-noocc, full-notight; settings of full combine with '+' (thr16+latency1)";
 }
+
+namespace {
+
+/// Applies one setting of `full` (an approximate setting or an ablation) to `m`.
+bool applyFullSetting(const std::string& part, ModeSpec& m) {
+    std::uint32_t n = 0;
+    if (part == "full") {
+    } else if (part == "latency1") {
+        m.scheduler.useLastFrameResults = true;
+    } else if (part == "overlap") {
+        m.scheduler.batchOverlapping = true;
+    } else if (part == "full-nohist") {
+        m.scheduler.useHistory = false;
+    } else if (part == "full-nobatch") {
+        m.scheduler.useBatching = false;
+    } else if (part == "full-noocc") {
+        m.scheduler.useOccupancyAccept = false;
+    } else if (part == "full-notight") {
+        m.scheduler.useTightVolumes = false;
+    } else if (numberAfter(part, "thr", n)) {
+        m.queries.visiblePixelThreshold = n;
+    } else if (numberAfter(part, "skip", n)) {
+        m.scheduler.history.maxSkipFrames = n;
+        m.scheduler.history.skipFramesPerVisible = 2;
+    } else if (numberAfter(part, "small", n)) {
+        m.scheduler.smallFeaturePixels = n;
+    } else {
+        return false;
+    }
+    return true;
+}
+
+}  // namespace
 
 Expected<ModeSpec> modeFromName(const std::string& name) {
     ModeSpec m = fullMode(name);
-    std::uint32_t n = 0;
     if (name == "vfc") {
         m.scheduler.mode = CullMode::Vfc;
     } else if (name == "simple") {
         m.scheduler.mode = CullMode::Simple;
-    } else if (name == "full") {
     } else if (name == "oracle") {
         m.oracle = true;
-    } else if (name == "latency1") {
-        m.scheduler.useLastFrameResults = true;
-    } else if (name == "overlap") {
-        m.scheduler.batchOverlapping = true;
-    } else if (name == "full-nohist") {
-        m.scheduler.useHistory = false;
-    } else if (name == "full-nobatch") {
-        m.scheduler.useBatching = false;
-    } else if (name == "full-noocc") {
-        m.scheduler.useOccupancyAccept = false;
-    } else if (name == "full-notight") {
-        m.scheduler.useTightVolumes = false;
-    } else if (numberAfter(name, "thr", n)) {
-        m.queries.visiblePixelThreshold = n;
-    } else if (numberAfter(name, "skip", n)) {
-        m.scheduler.history.maxSkipFrames = n;
-        m.scheduler.history.skipFramesPerVisible = 2;
-    } else if (numberAfter(name, "small", n)) {
-        m.scheduler.smallFeaturePixels = n;
     } else {
-        return Error{"--modes: unknown mode '" + name + "' (known: " + modeNamesHelp() + ")"};
+        // Settings of `full` combine with '+', e.g. thr16+latency1.
+        std::size_t start = 0;
+        while (true) {
+            const std::size_t plus = name.find('+', start);
+            const std::string part = name.substr(start, plus == std::string::npos ? std::string::npos : plus - start);
+            if (!applyFullSetting(part, m))
+                return Error{"--modes: unknown mode '" + part + "' in '" + name + "' (known: " + modeNamesHelp() + ")"};
+            if (plus == std::string::npos) break;
+            start = plus + 1;
+        }
     }
     if (Status s = validateSchedulerParams(m.scheduler); !s) return Error{"--modes: " + name + ": " + s.message()};
     return m;

@@ -33,7 +33,8 @@ struct ModeSpec {
 /// A named mode: vfc, simple, full, oracle; approximate presets thrN (pixel threshold N),
 /// latency1 (last frame's results), skipN (history: max skip N, 2 frames per visible
 /// answer), overlap (overlapping batches), smallN (small-feature culling below N pixels);
-/// ablations full-nohist, full-nobatch, full-noocc, full-notight. Error names the mode.
+/// ablations full-nohist, full-nobatch, full-noocc, full-notight. Settings of full combine
+/// with '+' (thr16+latency1). Error names the mode.
 Expected<ModeSpec> modeFromName(const std::string& name);
 /// A comma-separated list of names, e.g. "vfc,simple,full,oracle,thr16".
 Expected<std::vector<ModeSpec>> modesFromList(const std::string& list);
