@@ -33,12 +33,12 @@ struct RunOptions {
 };
 
 void writeCsvHeader(std::ofstream& f) {
-    f << "frame,ms_frame,ms_traversal,ms_wait,ms_draw,ms_update,queries,queries_occluded,skipped_history,"
+    f << "frame,ms_frame,ms_traversal,ms_query,ms_wait,ms_draw,ms_update,queries,queries_occluded,skipped_history,"
          "skipped_occupancy,visible_near,frustum_culled,nodes_visited,batches,parts,triangles\n";
 }
 
 void writeCsvRow(std::ofstream& f, std::uint64_t frame, const FrameStats& s) {
-    f << frame << ',' << s.frameMs << ',' << s.traversalMs << ',' << s.waitMs << ',' << s.drawMs << ',' << s.updateMs
+    f << frame << ',' << s.frameMs << ',' << s.traversalMs << ',' << s.queryMs << ',' << s.waitMs << ',' << s.drawMs << ',' << s.updateMs
       << ',' << s.queriesIssued << ',' << s.queriesOccluded << ',' << s.skippedByHistory << ',' << s.skippedByOccupancy
       << ',' << s.visibleNearOrInside << ',' << s.frustumCulled << ',' << s.nodesVisited << ',' << s.batches << ','
       << s.partsDrawn << ',' << s.trianglesDrawn << '\n';

@@ -79,6 +79,7 @@ std::vector<ModeSummary> summarise(const BenchResult& r) {
             const ModeFrame& f = row[m];
             ms.push_back(f.stats.frameMs);
             s.traversalMs += f.stats.traversalMs;
+            s.queryMs += f.stats.queryMs;
             s.waitMs += f.stats.waitMs;
             s.drawMs += f.stats.drawMs;
             s.parts += f.stats.partsDrawn;
@@ -101,7 +102,7 @@ std::vector<ModeSummary> summarise(const BenchResult& r) {
         const double n = static_cast<double>(ms.size());
         for (double v : ms) s.msMean += v;
         s.msMean /= n;
-        for (double* v : {&s.traversalMs, &s.waitMs, &s.drawMs, &s.parts, &s.triangles, &s.queries, &s.occluded,
+        for (double* v : {&s.traversalMs, &s.queryMs, &s.waitMs, &s.drawMs, &s.parts, &s.triangles, &s.queries, &s.occluded,
                           &s.skippedHistory, &s.skippedOccupancy, &s.batches, &s.pctWrongMean, &s.falsePositives})
             *v /= n;
         std::sort(ms.begin(), ms.end());
@@ -132,7 +133,7 @@ std::vector<ModeSummary> summarise(const BenchResult& r) {
 Status writeFramesCsv(const BenchResult& r, const fs::path& path) {
     std::ofstream f;
     if (Status s = openFor(f, path); !s) return s;
-    f << "frame,mode,ms_frame,ms_traversal,ms_wait,ms_draw,ms_update,queries,queries_occluded,queries_timed_out,"
+    f << "frame,mode,ms_frame,ms_traversal,ms_query,ms_wait,ms_draw,ms_update,queries,queries_occluded,queries_timed_out,"
          "skipped_history,skipped_occupancy,visible_near,frustum_culled,small_feature_culled,nodes_visited,batches,"
          "parts,triangles,visible_parts,frustum_parts,false_negatives,false_negative_pixels,false_positives,"
          "pixels_wrong,pixels_wrong_pct,largest_wrong_region,frame_update_ms,ground_truth_ms\n";
@@ -142,7 +143,7 @@ Status writeFramesCsv(const BenchResult& r, const fs::path& path) {
             const FrameStats& s = r.frames[i][m].stats;
             const PartErrors& p = r.frames[i][m].parts;
             const ImageDiff& d = r.frames[i][m].image;
-            f << i << ',' << r.modes[m].name << ',' << s.frameMs << ',' << s.traversalMs << ',' << s.waitMs << ','
+            f << i << ',' << r.modes[m].name << ',' << s.frameMs << ',' << s.traversalMs << ',' << s.queryMs << ',' << s.waitMs << ','
               << s.drawMs << ',' << s.updateMs << ',' << s.queriesIssued << ',' << s.queriesOccluded << ','
               << s.queriesTimedOut << ',' << s.skippedByHistory << ',' << s.skippedByOccupancy << ','
               << s.visibleNearOrInside << ',' << s.frustumCulled << ',' << s.smallFeatureCulled << ','
@@ -159,13 +160,13 @@ Status writeFramesCsv(const BenchResult& r, const fs::path& path) {
 Status writeSummaryCsv(const std::vector<ModeSummary>& summary, const fs::path& path) {
     std::ofstream f;
     if (Status s = openFor(f, path); !s) return s;
-    f << "mode,frames,ms_mean,ms_median,ms_min,ms_max,ms_traversal,ms_wait,ms_draw,ratio_vfc,ratio_oracle,parts,"
+    f << "mode,frames,ms_mean,ms_median,ms_min,ms_max,ms_traversal,ms_query,ms_wait,ms_draw,ratio_vfc,ratio_oracle,parts,"
          "triangles,queries,queries_occluded,skipped_history,skipped_occupancy,batches,pixels_wrong_pct_mean,"
          "pixels_wrong_pct_max,frames_wrong,false_negatives,false_negative_pixels,false_positives_per_frame,"
          "largest_wrong_region,timeouts,pareto\n";
     for (const ModeSummary& s : summary)
         f << s.name << ',' << s.frames << ',' << s.msMean << ',' << s.msMedian << ',' << s.msMin << ',' << s.msMax
-          << ',' << s.traversalMs << ',' << s.waitMs << ',' << s.drawMs << ',' << s.ratioVfc << ',' << s.ratioOracle
+          << ',' << s.traversalMs << ',' << s.queryMs << ',' << s.waitMs << ',' << s.drawMs << ',' << s.ratioVfc << ',' << s.ratioOracle
           << ',' << s.parts << ',' << s.triangles << ',' << s.queries << ',' << s.occluded << ',' << s.skippedHistory
           << ',' << s.skippedOccupancy << ',' << s.batches << ',' << s.pctWrongMean << ',' << s.pctWrongMax << ','
           << s.framesWrong << ',' << s.falseNegatives << ',' << s.falseNegativePixels << ',' << s.falsePositives
@@ -284,18 +285,20 @@ Status writeReport(const BenchResult& r, const std::vector<ModeSummary>& summary
       << "(not counted in any mode)\n"
       << "- modes run interleaved: per frame the scene moves once, then every mode renders that frame with its own "
          "scheduler and history, vfc first (its image is the reference)\n\n";
-    f << "| mode | ms/frame | median | vs vfc | vs oracle | parts drawn | triangles | queries | occluded | wait ms |"
+    f << "| mode | ms/frame | median | vs vfc | vs oracle | parts drawn | triangles | queries | occluded | sched ms | query ms | wait ms |"
          " % px wrong (mean) | % px wrong (max) | frames wrong | false neg. (parts) | false neg. (px) |"
          " false pos./frame | largest wrong region (px) | timeouts |\n"
-      << "|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|\n";
+      << "|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|\n";
     for (const ModeSummary& s : summary)
         f << "| " << s.name << (s.pareto ? " *" : "") << " | " << fmt(s.msMean, 2) << " | " << fmt(s.msMedian, 2)
           << " | " << fmt(s.ratioVfc, 2) << " | " << fmt(s.ratioOracle, 2) << " | " << fmt(s.parts, 1) << " | "
           << fmt(s.triangles, 0) << " | " << fmt(s.queries, 1) << " | " << fmt(s.occluded, 1) << " | "
-          << fmt(s.waitMs, 2) << " | " << fmt(s.pctWrongMean, 4) << " | " << fmt(s.pctWrongMax, 4) << " | "
+          << fmt(s.traversalMs, 2) << " | " << fmt(s.queryMs, 2) << " | " << fmt(s.waitMs, 2) << " | " << fmt(s.pctWrongMean, 4) << " | " << fmt(s.pctWrongMax, 4) << " | "
           << s.framesWrong << " | " << s.falseNegatives << " | " << s.falseNegativePixels << " | "
           << fmt(s.falsePositives, 1) << " | " << s.largestRegion << " | " << s.timeouts << " |\n";
     f << "\nColumns: means per frame unless noted; *vs vfc* and *vs oracle* are mean ms divided by that mode's; "
+         "*sched ms* is CPU time in traversal and scheduling, *query ms* time inside the query backend (issuing "
+         "volumes, polling; on llvmpipe a poll can flush the command stream), *wait ms* time blocked on a result; "
          "*% px wrong* compares the frame exactly (RGBA) with the vfc frame; false negatives are visible parts "
          "(ground truth) not drawn, summed over frames, with the pixels they own; false positives are drawn parts "
          "with no visible pixel; the largest wrong region is the biggest 4-connected blob of wrong pixels in any "

@@ -21,7 +21,7 @@ struct ModeSummary {
     bool oracle = false;
     std::size_t frames = 0;
     double msMean = 0, msMedian = 0, msMin = 0, msMax = 0;
-    double traversalMs = 0, waitMs = 0, drawMs = 0;
+    double traversalMs = 0, queryMs = 0, waitMs = 0, drawMs = 0;
     double parts = 0, triangles = 0, queries = 0, occluded = 0, skippedHistory = 0, skippedOccupancy = 0, batches = 0;
     double pctWrongMean = 0, pctWrongMax = 0;
     std::uint32_t framesWrong = 0;            ///< frames with at least one pixel unlike vfc

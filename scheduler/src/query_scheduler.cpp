@@ -97,9 +97,37 @@ FrameStats QueryScheduler::cullFrame(const TwoLevelTree& tree, const Camera& cam
         case CullMode::Simple: runSimple(); break;
         case CullMode::Full: runFull(); break;
     }
-    st.traversalMs = std::max(0.0, msSince(t0) - st.waitMs - st.drawMs);
+    st.traversalMs = std::max(0.0, msSince(t0) - st.waitMs - st.drawMs - st.queryMs);
     stats_ = nullptr;
     return st;
+}
+
+// Backend calls are timed apart from scheduling: on a software rasteriser a poll may
+// flush the command stream, which is GL work, not the scheduler's.
+void QueryScheduler::timedBeginBatch() {
+    const auto t0 = Clock::now();
+    backend_->beginBatch();
+    stats_->queryMs += msSince(t0);
+}
+
+void QueryScheduler::timedEndBatch() {
+    const auto t0 = Clock::now();
+    backend_->endBatch();
+    stats_->queryMs += msSince(t0);
+}
+
+QueryId QueryScheduler::timedIssue(const QueryVolume& volume) {
+    const auto t0 = Clock::now();
+    const QueryId id = backend_->issue(volume);
+    stats_->queryMs += msSince(t0);
+    return id;
+}
+
+QueryResult QueryScheduler::timedPoll(QueryId id) {
+    const auto t0 = Clock::now();
+    const QueryResult r = backend_->poll(id);
+    stats_->queryMs += msSince(t0);
+    return r;
 }
 
 bool QueryScheduler::projectRect(const Aabb& box, ScreenRect& out) const {
@@ -257,9 +285,9 @@ void QueryScheduler::runSimple() {
         h.lastTouchedFrame = frame_;
         if (ft == FirstTest::Invisible) continue;
         if (ft == FirstTest::NeedQuery) {
-            backend_->beginBatch();
-            const QueryId id = backend_->issue(QueryVolume::fromAabb(box));
-            backend_->endBatch();
+            timedBeginBatch();
+            const QueryId id = timedIssue(QueryVolume::fromAabb(box));
+            timedEndBatch();
             ++stats_->queriesIssued;
             ++stats_->batches;
             const auto tw = Clock::now();
@@ -298,7 +326,7 @@ void QueryScheduler::collectLatent(bool block) {
     // for the next decision; never drawn from here.
     for (std::size_t i = 0; i < latent_.size();) {
         Pending& p = latent_[i];
-        QueryResult r = backend_->poll(p.id);
+        QueryResult r = timedPoll(p.id);
         if (r == QueryResult::NotReady && block) r = backend_->wait(p.id, params_.queryTimeoutMs);
         if (r == QueryResult::NotReady) {
             ++i;
@@ -323,14 +351,14 @@ void QueryScheduler::runFull() {
     bool batchOpen = false;
     auto openBatch = [&] {
         if (!batchOpen) {
-            backend_->beginBatch();
+            timedBeginBatch();
             batchOpen = true;
             ++stats_->batches;
         }
     };
     auto closeBatch = [&] {
         if (batchOpen) {
-            backend_->endBatch();
+            timedEndBatch();
             batchOpen = false;
         }
     };
@@ -350,7 +378,7 @@ void QueryScheduler::runFull() {
             }
         }
         openBatch();
-        const QueryId id = backend_->issue(queryVolume(ref, box));
+        const QueryId id = timedIssue(queryVolume(ref, box));
         ++stats_->queriesIssued;
         const bool marked = params_.useBatching;
         if (marked) pendingMap_.mark(rect);
@@ -372,7 +400,7 @@ void QueryScheduler::runFull() {
         // 1. Finish answered queries, oldest first; visible ones push their children.
         closeBatch();
         for (std::size_t i = 0; i < pending_.size();) {
-            const QueryResult r = backend_->poll(pending_[i].id);
+            const QueryResult r = timedPoll(pending_[i].id);
             if (r == QueryResult::NotReady) {
                 ++i;
                 continue;
@@ -414,7 +442,7 @@ void QueryScheduler::runFull() {
                 // Approximate: act on the previous answer now, read this query next frame.
                 if (!h.queryInFlight) {
                     openBatch();
-                    const QueryId id = backend_->issue(queryVolume(ref, box));
+                    const QueryId id = timedIssue(queryVolume(ref, box));
                     ++stats_->queriesIssued;
                     latent_.push_back({ref, id, rect, false});
                     h.queryInFlight = true;

@@ -6,7 +6,8 @@
 namespace dyncull {
 
 struct FrameStats {
-    double traversalMs = 0.0;  ///< CPU in tree update, traversal and scheduling (excludes waits and draws)
+    double traversalMs = 0.0;  ///< CPU in traversal and scheduling (excludes backend calls, waits and draws)
+    double queryMs = 0.0;      ///< in the query backend: issuing volumes, polling (a poll may flush GL)
     double waitMs = 0.0;       ///< blocked waiting for query results
     double drawMs = 0.0;       ///< CPU time submitting parts (and query volumes)
     double frameMs = 0.0;      ///< whole frame including the final glFinish

@@ -120,6 +120,10 @@ private:
     bool projectRect(const Aabb& box, ScreenRect& out) const;
     void finishQuery(Pending& p, QueryResult r);
 
+    void timedBeginBatch();
+    void timedEndBatch();
+    QueryId timedIssue(const QueryVolume& volume);
+    QueryResult timedPoll(QueryId id);
     void runVfc();
     void runSimple();
     void runFull();
