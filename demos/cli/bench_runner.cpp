@@ -51,6 +51,7 @@ ModeSpec fullMode(const std::string& name) {
 std::string modeNamesHelp() {
     return "vfc, simple, full, oracle; approximate: thrN (pixel threshold), latency1 (last frame's results), "
            "skipN (history max skip N, 2 per visible), overlap (overlapping batches), smallN (small-feature pixels); "
+           "backend: noflush (no glFlush after each batch); "
            "ablations: full-nohist, full-nobatch, full-noocc, full-notight; settings of full combine with '+' (thr16+latency1)";
 }
 
@@ -62,6 +63,8 @@ bool applyFullSetting(const std::string& part, ModeSpec& m) {
     if (part == "full") {
     } else if (part == "latency1") {
         m.scheduler.useLastFrameResults = true;
+    } else if (part == "noflush") {
+        m.queries.flushAfterBatch = false;
     } else if (part == "overlap") {
         m.scheduler.batchOverlapping = true;
     } else if (part == "full-nohist") {

@@ -141,7 +141,7 @@ void GlQueryBackend::endBatch() {
     if (savedCull_) glEnable(GL_CULL_FACE);
     if (!savedDepthTest_) glDisable(GL_DEPTH_TEST);
     // Submit now so the rasteriser works on the queries while the CPU traverses on.
-    glFlush();
+    if (params_.flushAfterBatch) glFlush();
 }
 
 QueryResult GlQueryBackend::fetch(QueryId id) {

@@ -18,6 +18,10 @@ class GlContext;
 
 struct GlQueryParams {
     std::uint32_t visiblePixelThreshold = 0;  ///< 0 = conservative (any sample passes)
+    /// glFlush at the end of every batch so the GPU starts on the queries while the CPU
+    /// traverses on. On llvmpipe each flush ends a binned scene; off, the first poll of
+    /// the batch submits it instead.
+    bool flushAfterBatch = true;
 };
 
 /// Owns GL query objects, a streaming vertex buffer for volumes and a depth-only program.
