@@ -257,6 +257,7 @@ Status runMeasurement(const MeasureOptions& o, std::vector<ModeSpec> modes, cons
                       std::vector<ModeSummary>* summaryOut) {
     if (o.size.x < 1 || o.size.y < 1) return Error{"--size: width and height must be at least 1"};
     if (o.frames == 0) return Error{"--frames: must be at least 1"};
+    if (o.stride == 0) return Error{"--stride: must be at least 1"};
     auto made = makeScene(o.scene, o.sceneOptions);
     if (!made) return Error{made.error().message};
     DemoScene& scene = **made;
@@ -285,7 +286,7 @@ Status runMeasurement(const MeasureOptions& o, std::vector<ModeSpec> modes, cons
     std::printf("modes (interleaved per frame, vfc first): %s\n", names.c_str());
     std::fflush(stdout);
     for (std::uint64_t f = 0; f < o.frames; ++f) {
-        if (Status s = (*runner)->runFrame(f); !s) return s;
+        if (Status s = (*runner)->runFrame(o.firstFrame + f * o.stride); !s) return s;
         if (!o.quiet && ((f + 1) % 10 == 0 || f + 1 == o.frames)) {
             std::fprintf(stderr, "frame %llu/%llu\n", static_cast<unsigned long long>(f + 1),
                          static_cast<unsigned long long>(o.frames));

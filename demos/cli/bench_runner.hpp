@@ -104,7 +104,9 @@ private:
 /// What `dyncull bench` and `dyncull sweep` share: scene, frames, size, output directory.
 struct MeasureOptions {
     std::string scene = "bunnies";
-    std::uint64_t frames = 60;
+    std::uint64_t frames = 60;      ///< frames measured
+    std::uint64_t firstFrame = 0;   ///< path frame of the first measured frame
+    std::uint64_t stride = 1;       ///< measured frame i is path frame firstFrame + i * stride
     glm::ivec2 size{640, 360};  ///< framebuffer, pixels
     std::string out;  ///< output directory; empty: out/measure_<scene>
     SceneOptions sceneOptions;

@@ -8,6 +8,25 @@
 
 namespace dyncull::cli {
 
+namespace {
+std::string& commandLineStorage() {
+    static std::string line;
+    return line;
+}
+}  // namespace
+
+void setCommandLine(int argc, const char* const* argv) {
+    std::string& line = commandLineStorage();
+    line.clear();
+    for (int i = 0; i < argc; ++i) {
+        if (i) line += ' ';
+        // The program as users call it, not the path it was started from.
+        line += i == 0 ? std::string("dyncull") : std::string(argv[i]);
+    }
+}
+
+const std::string& commandLine() { return commandLineStorage(); }
+
 Expected<glm::ivec2> parseSize(const std::string& text, const std::string& optionName) {
     const Error bad{optionName + ": expected WxH with sides 1..16384 (e.g. 1280x720), got '" + text + "'"};
     const std::size_t x = text.find_first_of("xX");

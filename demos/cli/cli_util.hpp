@@ -17,6 +17,11 @@ Expected<glm::ivec2> parseSize(const std::string& text, const std::string& optio
 /// Creates the parent directory of `file` if needed. Error names the directory.
 Status ensureParentDirectory(const std::filesystem::path& file);
 
+/// The command line as typed (argv joined by spaces), recorded by main() so reports can
+/// quote exactly what produced them.
+void setCommandLine(int argc, const char* const* argv);
+const std::string& commandLine();
+
 /// Prints "error: <message>" on stderr and exits the subcommand with code 1.
 [[noreturn]] void fail(const std::string& message);
 

@@ -35,8 +35,7 @@ void runBench(BenchOptions o) {
     auto modes = modesFromList(o.modes);
     if (!modes) fail(modes.error().message);
     if (o.measure.out.empty()) o.measure.out = "out/bench_" + o.measure.scene;
-    const std::string command = "dyncull bench " + o.measure.scene + " --modes " + o.modes + " --frames " +
-                                std::to_string(o.measure.frames) + " --size " + o.size + " --out " + o.measure.out;
+    const std::string command = commandLine();
     std::vector<ModeSummary> summary;
     if (Status s = runMeasurement(o.measure, modes.take(), command, &summary); !s) fail(s.message());
     std::printf("ratio full/vfc=%s\n", ratioText(summary, "full", "vfc").c_str());
@@ -61,7 +60,13 @@ void registerBench(CLI::App& app) {
     cmd->add_option("scene", o->measure.scene, "bunnies, powerplant, city, a directory of .ply/.obj parts, or a model file")
         ->capture_default_str();
     cmd->add_option("--modes", o->modes, "comma-separated modes: " + modeNamesHelp())->capture_default_str();
-    cmd->add_option("--frames", o->measure.frames, "frames to run")->capture_default_str();
+    cmd->add_option("--frames", o->measure.frames, "frames to measure")->capture_default_str();
+    cmd->add_option("--first", o->measure.firstFrame, "path frame of the first measured frame")->capture_default_str();
+    cmd->add_option("--stride", o->measure.stride,
+                    "measure every Nth frame of the path (the camera and objects move N times farther between "
+                    "measured frames, so visibility history has less coherence to use)")
+        ->check(CLI::Range(1, 1000))
+        ->capture_default_str();
     cmd->add_option("--size", o->size, "framebuffer size WxH")->capture_default_str();
     cmd->add_option("--out", o->measure.out, "output directory (default out/bench_<scene>)");
     cmd->add_flag("--quiet", o->measure.quiet, "no progress lines");

@@ -33,8 +33,7 @@ void runSweep(SweepOptions o) {
     }
     for (ModeSpec& m : *values) modes.push_back(std::move(m));
     if (o.measure.out.empty()) o.measure.out = "out/sweep_" + o.measure.scene;
-    const std::string command = "dyncull sweep " + o.measure.scene + " --param " + o.param + " --frames " +
-                                std::to_string(o.measure.frames) + " --size " + o.size + " --out " + o.measure.out;
+    const std::string command = commandLine();
     std::vector<ModeSummary> summary;
     if (Status s = runMeasurement(o.measure, std::move(modes), command, &summary); !s) fail(s.message());
     for (const ModeSummary& s : summary) {
@@ -53,7 +52,13 @@ void registerSweep(CLI::App& app) {
     cmd->add_option("scene", o->measure.scene, "bunnies, powerplant, city, a directory of .ply/.obj parts, or a model file")
         ->capture_default_str();
     cmd->add_option("--param", o->param, "NAME=v1,v2,... with NAME one of " + sweepParamsHelp())->required();
-    cmd->add_option("--frames", o->measure.frames, "frames to run")->capture_default_str();
+    cmd->add_option("--frames", o->measure.frames, "frames to measure")->capture_default_str();
+    cmd->add_option("--first", o->measure.firstFrame, "path frame of the first measured frame")->capture_default_str();
+    cmd->add_option("--stride", o->measure.stride,
+                    "measure every Nth frame of the path (the camera and objects move N times farther between "
+                    "measured frames, so visibility history has less coherence to use)")
+        ->check(CLI::Range(1, 1000))
+        ->capture_default_str();
     cmd->add_option("--size", o->size, "framebuffer size WxH")->capture_default_str();
     cmd->add_option("--out", o->measure.out, "output directory (default out/sweep_<scene>)");
     cmd->add_flag("--quiet", o->measure.quiet, "no progress lines");

@@ -51,6 +51,7 @@ TEST(FileCamera, CompactModelIsOrbitedWithoutRayCasting) {
     const Scene s = oneMeshScene(std::move(m));
     const FileCameraChoice c = chooseFileCamera(s, s.worldBounds());
     EXPECT_FALSE(c.walkthrough);
+    EXPECT_FALSE(c.elongated);
     EXPECT_EQ(c.enclosedFraction, 0.0);
 }
 

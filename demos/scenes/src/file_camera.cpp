@@ -77,7 +77,8 @@ FileCameraChoice chooseFileCamera(const Scene& scene, const Aabb& bounds) {
     const float longest = std::max({e.x, e.y, e.z});
     const float shortest = std::max(std::min({e.x, e.y, e.z}), 1e-6f * longest);
     FileCameraChoice c;
-    if (!(longest / shortest > 1.8f)) return c;
+    c.elongated = longest / shortest > 1.8f;
+    if (!c.elongated) return c;
     const std::vector<glm::vec3> eyes = walkEyes(bounds);
     c.enclosedFraction = enclosedFraction(scene, {eyes[1], eyes[2]}, sphereDirections(48));
     c.walkthrough = c.enclosedFraction > 0.7;

@@ -30,6 +30,7 @@ std::vector<glm::vec3> sphereDirections(int n);
 
 struct FileCameraChoice {
     bool walkthrough = false;
+    bool elongated = false;         ///< longest / shortest side of the bounds > 1.8
     double enclosedFraction = 0.0;  ///< measured on the walk path; 0 when not elongated
 };
 /// Walk through when the bounds are elongated (longest / shortest side > 1.8) and more

@@ -38,13 +38,14 @@ public:
         bounds_ = scene->worldBounds();
         const FileCameraChoice choice = chooseFileCamera(*scene, bounds_);
         walkthrough_ = choice.walkthrough;
-        const double enclosed = choice.enclosedFraction;
         description_ = path_ + ": " + std::to_string(scene->instances.size()) + " objects, " +
                        std::to_string(scene->meshes.size()) + " meshes, " +
                        std::to_string(scene->instancedTriangleCount()) + " triangles drawn (" +
                        std::to_string(after) + " after local-BSP splitting per mesh); camera: " +
-                       (walkthrough_ ? "walkthrough" : "orbit") + " (" + std::to_string(int(100.0 * enclosed + 0.5)) +
-                       "% of rays from the walk path meet a front face)";
+                       (walkthrough_ ? "walkthrough" : "orbit") +
+                       (choice.elongated ? " (elongated; " + std::to_string(int(100.0 * choice.enclosedFraction + 0.5)) +
+                                               "% of rays from the walk path meet a front face)"
+                                         : std::string(" (compact)"));
         setupMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         return {};
     }
