@@ -126,15 +126,6 @@ Error bad(const std::filesystem::path& path, const std::string& why) {
 
 }  // namespace
 
-std::uint64_t fnv1a64(const void* data, std::size_t size, std::uint64_t hash) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    for (std::size_t i = 0; i < size; ++i) {
-        hash ^= p[i];
-        hash *= 0x100000001b3ull;
-    }
-    return hash;
-}
-
 Status writeSceneCache(const std::filesystem::path& path, const PreparedScene& scene, std::uint64_t paramsHash) {
     Writer w;
     w.buffer().resize(kSceneCacheHeaderSize);

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <filesystem>
 
+#include "dyncull/objects/checksum.hpp"
 #include "dyncull/objects/error.hpp"
 #include "prepared_scene.hpp"
 
@@ -20,9 +21,6 @@ namespace dyncull {
 
 inline constexpr std::uint32_t kSceneCacheVersion = 1;
 inline constexpr std::size_t kSceneCacheHeaderSize = 40;
-
-/// FNV-1a 64-bit over `size` bytes, continuing from `hash`.
-std::uint64_t fnv1a64(const void* data, std::size_t size, std::uint64_t hash = 0xcbf29ce484222325ull);
 
 /// Writes `scene` to `path` (via a temporary file renamed into place, so readers never see
 /// a half-written cache). Errors name the path.
