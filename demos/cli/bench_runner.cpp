@@ -52,6 +52,7 @@ std::string modeNamesHelp() {
     return "vfc, simple, full, oracle; approximate: thrN (pixel threshold), latency1 (last frame's results), "
            "skipN (history max skip N, 2 per visible), overlap (overlapping batches), smallN (small-feature pixels); "
            "backend: noflush (no glFlush after each batch); "
+           "conservative: frontN (front-most N% of leaves drawn without queries); "
            "ablations: full-nohist, full-nobatch, full-noocc, full-notight; settings of full combine with '+' (thr16+latency1)";
 }
 
@@ -82,6 +83,8 @@ bool applyFullSetting(const std::string& part, ModeSpec& m) {
         m.scheduler.history.skipFramesPerVisible = 2;
     } else if (numberAfter(part, "small", n)) {
         m.scheduler.smallFeaturePixels = n;
+    } else if (numberAfter(part, "front", n)) {
+        m.scheduler.frontPercent = static_cast<float>(n);
     } else {
         return false;
     }

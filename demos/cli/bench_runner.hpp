@@ -33,6 +33,7 @@ struct ModeSpec {
 /// A named mode: vfc, simple, full, oracle; approximate presets thrN (pixel threshold N),
 /// latency1 (last frame's results), skipN (history: max skip N, 2 frames per visible
 /// answer), overlap (overlapping batches), smallN (small-feature culling below N pixels);
+/// frontN (conservative: the front-most N% of frustum leaves drawn without queries);
 /// ablations full-nohist, full-nobatch, full-noocc, full-notight. Settings of full combine
 /// with '+' (thr16+latency1). Error names the mode.
 Expected<ModeSpec> modeFromName(const std::string& name);

@@ -57,7 +57,7 @@ void registerBench(CLI::App& app) {
     auto o = std::make_shared<BenchOptions>();
     CLI::App* cmd = app.add_subcommand(
         "bench", "Measure culling modes and approximate settings interleaved: time, parts, queries, error vs ground truth");
-    cmd->add_option("scene", o->measure.scene, "bunnies, powerplant, city, a directory of .ply/.obj parts, or a model file")
+    cmd->add_option("scene", o->measure.scene, "bunnies, powerplant, city, a directory of .ply/.obj parts, a model file, or a .dsub file from dyncull subdivide")
         ->capture_default_str();
     cmd->add_option("--modes", o->modes, "comma-separated modes: " + modeNamesHelp())->capture_default_str();
     cmd->add_option("--frames", o->measure.frames, "frames to measure")->capture_default_str();

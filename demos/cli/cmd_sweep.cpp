@@ -49,7 +49,7 @@ void runSweep(SweepOptions o) {
 void registerSweep(CLI::App& app) {
     auto o = std::make_shared<SweepOptions>();
     CLI::App* cmd = app.add_subcommand("sweep", "Speed-accuracy curve of full across one parameter (with vfc and oracle)");
-    cmd->add_option("scene", o->measure.scene, "bunnies, powerplant, city, a directory of .ply/.obj parts, or a model file")
+    cmd->add_option("scene", o->measure.scene, "bunnies, powerplant, city, a directory of .ply/.obj parts, a model file, or a .dsub file from dyncull subdivide")
         ->capture_default_str();
     cmd->add_option("--param", o->param, "NAME=v1,v2,... with NAME one of " + sweepParamsHelp())->required();
     cmd->add_option("--frames", o->measure.frames, "frames to measure")->capture_default_str();

@@ -12,5 +12,6 @@ void registerRun(CLI::App& app);
 void registerInspect(CLI::App& app);
 void registerBench(CLI::App& app);
 void registerSweep(CLI::App& app);
+void registerSubdivide(CLI::App& app);
 
 }  // namespace dyncull::cli

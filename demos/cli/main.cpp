@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
     dyncull::cli::registerInspect(app);
     dyncull::cli::registerBench(app);
     dyncull::cli::registerSweep(app);
+    dyncull::cli::registerSubdivide(app);
     CLI11_PARSE(app, argc, argv);
     return 0;
 }

@@ -15,6 +15,7 @@ glm::vec4 nodeStateColour(NodeState s) {
         case NodeState::VisibleHistory: return {1.00f, 0.88f, 0.20f, 1.0f};
         case NodeState::VisibleOccupancy: return {0.20f, 0.95f, 0.95f, 1.0f};
         case NodeState::VisibleNear: return {1.00f, 1.00f, 1.00f, 1.0f};
+        case NodeState::VisibleFront: return {1.00f, 0.60f, 0.15f, 1.0f};
         case NodeState::VisibleVfc: return {0.75f, 0.80f, 0.75f, 1.0f};
     }
     return {1, 1, 1, 1};
@@ -68,11 +69,11 @@ void NodeBoxView::drawText(Engine& engine, const std::vector<std::string>& lines
     }
     if (legend) {
         static const NodeState kShown[] = {NodeState::Occluded, NodeState::VisibleQueried, NodeState::VisibleHistory,
-                                           NodeState::VisibleOccupancy, NodeState::VisibleNear, NodeState::VisibleVfc,
-                                           NodeState::SmallFeature, NodeState::FrustumCulled};
+                                           NodeState::VisibleOccupancy, NodeState::VisibleNear, NodeState::VisibleFront,
+                                           NodeState::VisibleVfc, NodeState::SmallFeature, NodeState::FrustumCulled};
         static const char* const kLabel[] = {"occluded", "visible (queried)", "visible (history, no query)",
                                              "visible (occupancy, no query)", "visible (near/inside)",
-                                             "in frustum (vfc mode)", "small feature", "frustum culled"};
+                                             "visible (front-most, no query)", "in frustum (vfc mode)", "small feature", "frustum culled"};
         const int rowH = kLineAdvance * scale;
         const int n = static_cast<int>(std::size(kShown));
         const int swatch = kGlyphHeight * scale;

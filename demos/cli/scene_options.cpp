@@ -27,8 +27,14 @@ void addGeneratedSceneOptions(CLI::App& cmd, SceneOptions& o) {
         "--city-blocks", [&o](const std::uint32_t& n) { o.city.blocksX = o.city.blocksZ = n; },
         "city: blocks along each axis (default 20)");
     cmd.add_option_function<unsigned>(
-        "--threads", [&o](const unsigned& n) { o.plant.threads = o.city.threads = n; },
-        "powerplant/city: threads for the local BSP builds (default 2)");
+        "--threads", [&o](const unsigned& n) { o.plant.threads = o.city.threads = o.subdivide.threads = n; },
+        "powerplant/city: threads for the local BSP builds and --subdivide (default 2)");
+    cmd.add_option("--subdivide", o.subdivide.method,
+                   "static scenes: cut the whole model into objects first: phbvo, dbvs, octree or grid");
+    cmd.add_option("--max-tris", o.subdivide.maxTriangles, "--subdivide: maximum triangles per leaf (object)")
+        ->capture_default_str();
+    cmd.add_option("--collapse", o.subdivide.collapseTo, "--subdivide: at most this many children per node (0 keeps the tree)")
+        ->capture_default_str();
 }
 
 void addSchedulerOptions(CLI::App& cmd, SchedulerFlags& f) {
@@ -40,6 +46,9 @@ void addSchedulerOptions(CLI::App& cmd, SchedulerFlags& f) {
     cmd.add_option("--max-skip", f.maxSkip, "full: maximum frames a visible node skips its query")->capture_default_str();
     cmd.add_option("--pixel-threshold", f.pixelThreshold,
                    "cull nodes with at most this many visible samples (0 = conservative)")->capture_default_str();
+    cmd.add_option("--front-percent", f.frontPercent,
+                   "simple/full: draw the front-most N% of the leaves in the frustum without queries (conservative)")
+        ->capture_default_str();
 }
 
 SchedulerParams toParams(const SchedulerFlags& f, CullMode mode) {
@@ -51,6 +60,7 @@ SchedulerParams toParams(const SchedulerFlags& f, CullMode mode) {
     p.useTightVolumes = !f.noTight;
     p.maxQueriesInFlight = f.maxInFlight;
     p.history.maxSkipFrames = f.maxSkip;
+    p.frontPercent = f.frontPercent;
     return p;
 }
 

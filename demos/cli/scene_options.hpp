@@ -14,7 +14,7 @@ void addBunnyOptions(CLI::App& cmd, BunnySwarmOptions& o);
 
 /// Adds the generated-scene options (power plant, city, directory scenes, cache):
 /// --scene-dir --cache-dir --no-cache --plant-seed --plant-size --plant-detail --city-seed
-/// --city-blocks --threads.
+/// --city-blocks --threads, and --subdivide --max-tris --collapse for static scenes.
 void addGeneratedSceneOptions(CLI::App& cmd, SceneOptions& o);
 
 /// Scheduler switches for `full` ablations and tuning.
@@ -23,6 +23,7 @@ struct SchedulerFlags {
     std::uint32_t maxInFlight = SchedulerParams{}.maxQueriesInFlight;
     std::uint32_t maxSkip = SchedulerParams{}.history.maxSkipFrames;
     std::uint32_t pixelThreshold = 0;
+    float frontPercent = 0.0f;
 };
 void addSchedulerOptions(CLI::App& cmd, SchedulerFlags& f);
 SchedulerParams toParams(const SchedulerFlags& f, CullMode mode);

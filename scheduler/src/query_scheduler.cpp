@@ -36,6 +36,7 @@ const char* toString(NodeState s) {
         case NodeState::VisibleHistory: return "visible_history";
         case NodeState::VisibleOccupancy: return "visible_occupancy";
         case NodeState::VisibleNear: return "visible_near";
+        case NodeState::VisibleFront: return "visible_front";
         case NodeState::VisibleVfc: return "visible_vfc";
     }
     return "?";
@@ -53,6 +54,7 @@ Status validateSchedulerParams(const SchedulerParams& p) {
     if (p.occupancyTileSize <= 0) return Error{"occupancyTileSize must be positive"};
     if (!(p.queryTimeoutMs > 0.0)) return Error{"queryTimeoutMs must be positive"};
     if (p.history.maxSkipFrames > 1000) return Error{"history.maxSkipFrames must be at most 1000"};
+    if (!(p.frontPercent >= 0.0f && p.frontPercent <= 100.0f)) return Error{"frontPercent must be in [0, 100]"};
     return {};
 }
 
@@ -92,6 +94,9 @@ FrameStats QueryScheduler::cullFrame(const TwoLevelTree& tree, const Camera& cam
     backend.beginFrame(camera, width, height);
     const Aabb rootBox = tree.worldBox(tree.root());
     if (!rootBox.empty()) active_.push_back(tree.root());
+    frontBudget_ = frontLeavesSeen_ = 0;
+    if (params_.mode != CullMode::Vfc && params_.frontPercent > 0.0f && !rootBox.empty())
+        frontBudget_ = static_cast<std::uint32_t>(std::ceil(double(params_.frontPercent) / 100.0 * countFrustumLeaves()));
     switch (params_.mode) {
         case CullMode::Vfc: runVfc(); break;
         case CullMode::Simple: runSimple(); break;
@@ -203,6 +208,14 @@ QueryScheduler::FirstTest QueryScheduler::firstVisibilityTest(NodeRef ref, const
         trace(ref, box, NodeState::FrustumCulled);
         return FirstTest::Invisible;
     }
+    if (frontLeavesSeen_ < frontBudget_) {
+        // Front-most leaves (k-DOP paper, section 4): rarely occluded, drawn untested.
+        // Inner nodes met before the budget is spent are opened the same way.
+        if (tree_->isDrawable(ref)) ++frontLeavesSeen_;
+        ++st.visibleFront;
+        trace(ref, box, NodeState::VisibleFront);
+        return FirstTest::Visible;
+    }
     if (params_.mode != CullMode::Full) return FirstTest::NeedQuery;
     if (params_.smallFeaturePixels > 0 && static_cast<std::uint32_t>(rect.area()) < params_.smallFeaturePixels) {
         ++st.smallFeatureCulled;
@@ -254,6 +267,42 @@ void QueryScheduler::processVisible(NodeRef ref, NodeHistory& h) {
     tree_->expand(ref, camera_.position, scratch_);
     // active_ is a stack whose back is processed next: push the farthest first.
     for (auto it = scratch_.rbegin(); it != scratch_.rend(); ++it) active_.push_back(*it);
+}
+
+std::uint32_t QueryScheduler::countFrustumLeaves() const {
+    // The k-DOP paper's list L: leaves not outside the frustum, by a hierarchical walk of
+    // both levels (no sorting, no screen projection).
+    const LooseBsp& scene = tree_->scene();
+    const SceneObjects& objs = tree_->objects();
+    std::uint32_t leaves = 0;
+    std::vector<std::uint32_t> stack{scene.root()}, local;
+    while (!stack.empty()) {
+        const LooseBspNode& node = scene.nodes()[stack.back()];
+        stack.pop_back();
+        if (node.subtreeObjects == 0 || frustum_.outside(node.box)) continue;
+        for (std::uint32_t o = node.firstObject; o != kInvalidIndex; o = scene.nextObject(o)) {
+            if (frustum_.outside(objs.worldBox(o))) continue;
+            const LocalBsp& model = objs.model(objs.modelOf(o));
+            local.assign(1, 0);
+            while (!local.empty()) {
+                const std::uint32_t n = local.back();
+                local.pop_back();
+                const LocalBspNode& ln = model.nodes[n];
+                if (n != 0 && (ln.indexCount == 0 || frustum_.outside(transformAabb(objs.matrix(o), ln.box)))) continue;
+                if (ln.isLeaf()) {
+                    ++leaves;
+                } else {
+                    local.push_back(ln.children[0]);
+                    local.push_back(ln.children[1]);
+                }
+            }
+        }
+        if (!node.isLeaf()) {
+            stack.push_back(node.children[0]);
+            stack.push_back(node.children[1]);
+        }
+    }
+    return leaves;
 }
 
 void QueryScheduler::runVfc() {

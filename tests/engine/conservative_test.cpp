@@ -76,7 +76,7 @@ TEST(Conservative, EveryConservativeModeDrawsTheVfcImage) {
     auto scene = makeBunnySwarm(bo);
     ASSERT_TRUE(scene->populate(engine).ok());
 
-    const char* conservative = "vfc,simple,full,full-nohist,full-nobatch,full-noocc,full-notight,oracle,thr64";
+    const char* conservative = "vfc,simple,full,full-nohist,full-nobatch,full-noocc,full-notight,front10,oracle,thr64";
     auto modes = cli::modesFromList(conservative);
     ASSERT_TRUE(modes.ok()) << modes.error().message;
     auto runner = cli::BenchRunner::create(engine, *scene, modes.take());
@@ -115,6 +115,51 @@ TEST(Conservative, EveryConservativeModeDrawsTheVfcImage) {
     EXPECT_GT(visibleSeen, 100u);
     EXPECT_GT(occludedSeen, 100u);
     EXPECT_GT(thresholdMisses, 0u) << "a 64-pixel threshold should drop some small visible parts";
+    EXPECT_EQ(ctx->checkErrors(), 0u);
+    fs::remove_all(dir);
+}
+
+TEST(Conservative, SubdividedStaticModelsDrawTheVfcImage) {
+    // A static model cut into objects by each method (issue 8), on the fly and through a
+    // subdivision file: full and front-most-10% draw the vfc image with nothing missing.
+    const fs::path dir = fs::temp_directory_path() / ("dyncull_subdivided_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    const fs::path ply = dir / "blob.ply";
+    writeBlobPly(ply, 48, 96);
+    auto ctx = test::headless(320, 180);
+    ASSERT_TRUE(ctx);
+    for (const char* method : {"phbvo", "dbvs", "octree", "grid"}) {
+        SceneOptions options;
+        options.subdivide.method = method;
+        options.subdivide.maxTriangles = 500;
+        options.subdivide.collapseTo = 4;
+        auto saved = subdivideStaticScene(ply.string(), options);
+        ASSERT_TRUE(saved) << saved.error().message;
+        const fs::path file = dir / (std::string(method) + ".dsub");
+        ASSERT_TRUE(writeSubdivisionFile(file, *saved));
+        for (const std::string& source : {ply.string(), file.string()}) {
+            SCOPED_TRACE(std::string(method) + " " + source);
+            auto engineOr = Engine::create(*ctx);
+            ASSERT_TRUE(engineOr.ok());
+            Engine& engine = **engineOr;
+            auto scene = makeScene(source, options);
+            ASSERT_TRUE(scene) << scene.error().message;
+            ASSERT_TRUE((*scene)->populate(engine).ok());
+            EXPECT_EQ(engine.objects().objectCount(), saved->subdivision.stats.leaves);
+            EXPECT_GE(saved->subdivision.stats.leaves, 9216u / 500u);
+            auto modes = cli::modesFromList("vfc,full,front10");
+            ASSERT_TRUE(modes.ok());
+            auto runner = cli::BenchRunner::create(engine, **scene, modes.take());
+            ASSERT_TRUE(runner.ok()) << runner.error().message;
+            for (std::uint64_t frame = 0; frame < 4; ++frame) {
+                ASSERT_TRUE((*runner)->runFrame(frame * 50).ok());
+                for (const cli::ModeFrame& m : (*runner)->result().frames.back()) {
+                    EXPECT_LE(m.image.percentDiffering, 0.01);
+                    EXPECT_EQ(m.parts.falseNegatives, 0u);
+                }
+            }
+        }
+    }
     EXPECT_EQ(ctx->checkErrors(), 0u);
     fs::remove_all(dir);
 }

@@ -291,3 +291,47 @@ TEST(QueryScheduler, ParamsAreValidated) {
     EXPECT_FALSE(parseCullMode("fast").ok());
     EXPECT_EQ(parseCullMode("full").value(), CullMode::Full);
 }
+
+TEST(QueryScheduler, FrontMostLeavesAreDrawnWithoutQueries) {
+    // k-DOP paper, section 4: the first frontPercent of the frustum leaves in front-to-back
+    // order are drawn untested. Every query answers "occluded", so what is drawn is exactly
+    // the front budget; at 100% everything in the frustum is drawn with no query at all.
+    TestScene s(6, 5);
+    ScriptedBackend vfcBackend;
+    SchedulerParams vfc;
+    vfc.mode = CullMode::Vfc;
+    const auto reference = drawnWith(s, vfc, vfcBackend);
+    ASSERT_EQ(reference.size(), 30u);
+    std::uint32_t nearest = 0;
+    float nearestDist = 1e30f;
+    for (std::uint32_t o : reference) {
+        const float d = glm::length(s.objects.worldBox(o).center());
+        if (d < nearestDist) {
+            nearestDist = d;
+            nearest = o;
+        }
+    }
+    for (CullMode mode : {CullMode::Simple, CullMode::Full}) {
+        for (float percent : {10.0f, 50.0f, 100.0f}) {
+            ScriptedBackend b;
+            b.rule = [](const QueryVolume&) { return QueryResult::Occluded; };
+            SchedulerParams p;
+            p.mode = mode;
+            p.useOccupancyAccept = false;
+            p.frontPercent = percent;
+            FrameStats st;
+            const auto drawn = drawnWith(s, p, b, &st);
+            const auto budget = static_cast<std::size_t>(std::ceil(percent / 100.0f * 30.0f));
+            EXPECT_EQ(drawn.size(), budget) << toString(mode) << " " << percent;
+            EXPECT_EQ(drawn.count(nearest), 1u) << toString(mode) << " " << percent;
+            for (std::uint32_t o : drawn) EXPECT_EQ(reference.count(o), 1u);
+            EXPECT_GE(st.visibleFront, budget);
+            if (percent == 100.0f) {
+                EXPECT_EQ(b.issued, 0);
+            }
+        }
+    }
+    SchedulerParams bad;
+    bad.frontPercent = 150.0f;
+    EXPECT_FALSE(validateSchedulerParams(bad));
+}

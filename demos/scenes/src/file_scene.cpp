@@ -9,6 +9,35 @@
 #include "file_camera.hpp"
 
 namespace dyncull {
+
+Camera staticModelCamera(const Aabb& bounds, bool walkthrough, std::uint64_t frame, float aspect) {
+    Camera c = Camera::framing(bounds, aspect);
+    const glm::vec3 centre = bounds.center();
+    const glm::vec3 e = bounds.extent();
+    const float radius = 0.5f * glm::length(e);
+    if (walkthrough) {
+        const WalkAxes w = walkAxes(bounds);
+        const std::vector<glm::vec3> targets = {w.base + 0.2f * w.along, w.base + 0.7f * w.along - w.side,
+                                                w.base + 1.2f * w.along, w.base + 2.0f * w.along + w.side};
+        CameraPath(walkEyes(bounds), targets, kStaticModelFrames / 3, false).apply(frame, c);
+        c.nearPlane = 1e-3f * radius;
+        c.farPlane = 3.0f * radius;
+    } else {
+        CameraPath::orbit(centre, 1.6f * radius / std::sin(0.5f * c.fovYRadians) * 0.6f, 0.35f * radius, kStaticModelFrames)
+            .apply(frame, c);
+        c.nearPlane = 1e-2f * radius;
+        c.farPlane = 6.0f * radius;
+    }
+    return c;
+}
+
+bool staticModelWalkthrough(const Mesh& soup) {
+    Scene scene;
+    scene.meshes.push_back(soup);
+    scene.instances.push_back({0, glm::mat4(1.0f), {}});
+    return chooseFileCamera(scene, soup.bounds()).walkthrough;
+}
+
 namespace {
 
 class FileScene final : public DemoScene {
@@ -53,30 +82,12 @@ public:
     Status update(Engine&, std::uint64_t) override { return {}; }
 
     Camera camera(std::uint64_t frame, float aspect) const override {
-        Camera c = Camera::framing(bounds_, aspect);
-        const glm::vec3 centre = bounds_.center();
-        const glm::vec3 e = bounds_.extent();
-        const float radius = 0.5f * glm::length(e);
-        if (walkthrough_) {
-            const WalkAxes w = walkAxes(bounds_);
-            const std::vector<glm::vec3> targets = {w.base + 0.2f * w.along, w.base + 0.7f * w.along - w.side,
-                                                    w.base + 1.2f * w.along, w.base + 2.0f * w.along + w.side};
-            CameraPath(walkEyes(bounds_), targets, kFrames / 3, false).apply(frame, c);
-            c.nearPlane = 1e-3f * radius;
-            c.farPlane = 3.0f * radius;
-        } else {
-            CameraPath::orbit(centre, 1.6f * radius / std::sin(0.5f * c.fovYRadians) * 0.6f, 0.35f * radius, kFrames)
-                .apply(frame, c);
-            c.nearPlane = 1e-2f * radius;
-            c.farPlane = 6.0f * radius;
-        }
-        return c;
+        return staticModelCamera(bounds_, walkthrough_, frame, aspect);
     }
 
-    std::uint64_t defaultFrames() const override { return kFrames; }
+    std::uint64_t defaultFrames() const override { return kStaticModelFrames; }
 
 private:
-    static constexpr std::uint32_t kFrames = 240;
     std::string path_;
     std::string description_;
     Aabb bounds_;
@@ -110,6 +121,13 @@ Expected<std::unique_ptr<DemoScene>> makeScene(const std::string& nameOrPath, co
         CityOptions city = options.city;
         city.cache = options.cache;
         return makeCity(city);
+    }
+    if (std::filesystem::path(nameOrPath).extension() == ".dsub") return makeSubdivisionFileScene(nameOrPath, options);
+    if (!options.subdivide.method.empty()) {
+        if (nameOrPath == "bunnies") return Error{"--subdivide: the bunny swarm is dynamic; subdivide a static scene"};
+        if (!std::filesystem::exists(nameOrPath) && nameOrPath != "powerplant" && nameOrPath != "city")
+            return Error{nameOrPath + ": not a built-in scene and no such file"};
+        return makeSubdividedScene(nameOrPath, options);
     }
     if (std::filesystem::is_directory(nameOrPath)) return makeSceneDir(nameOrPath);
     if (std::filesystem::exists(nameOrPath)) return makeFileScene(nameOrPath);

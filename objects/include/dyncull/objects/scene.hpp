@@ -29,4 +29,12 @@ struct Scene {
     Aabb worldBounds() const;  ///< union of every instance's transformed mesh bounds
 };
 
+/// Every instance of `scene` transformed into world space and merged into one mesh named
+/// `name` (a triangle soup for subdividing a static model): positions by the instance
+/// matrix, normals by its inverse transpose (renormalised; computed first for meshes
+/// without), winding flipped under mirroring transforms. The caller owns the result; its
+/// size is the instanced size (shared meshes are copied once per instance). In
+/// objects/src/flatten_scene.cpp.
+Mesh flattenScene(const Scene& scene, const std::string& name);
+
 }  // namespace dyncull

@@ -18,6 +18,7 @@ struct FrameStats {
     std::uint32_t skippedByHistory = 0;  ///< queries not issued thanks to visibility history
     std::uint32_t skippedByOccupancy = 0;  ///< visible without a query: rectangle touched empty screen
     std::uint32_t visibleNearOrInside = 0;  ///< visible without a query: camera inside / near plane crossed
+    std::uint32_t visibleFront = 0;  ///< visible without a query: front-most leaves (SchedulerParams::frontPercent)
     std::uint32_t frustumCulled = 0;
     std::uint32_t smallFeatureCulled = 0;  ///< approximate small-feature setting
     std::uint32_t nodesVisited = 0;

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "dyncull/bsp/subdivision.hpp"
+#include "dyncull/bsp/subdivision_file.hpp"
 #include "dyncull/engine/engine.hpp"
 #include "dyncull/objects/camera.hpp"
 #include "dyncull/objects/error.hpp"
@@ -68,6 +70,14 @@ std::unique_ptr<DemoScene> makeBunnySwarm(const BunnySwarmOptions& options);
 /// outside for compact models, a walkthrough along the long axis for interiors.
 std::unique_ptr<DemoScene> makeFileScene(const std::string& path);
 
+/// The automatic camera of file scenes for a model with world box `bounds`: a walkthrough
+/// or an orbit, at `frame` of a kStaticModelFrames-frame path, for a viewport of aspect `aspect`.
+Camera staticModelCamera(const Aabb& bounds, bool walkthrough, std::uint64_t frame, float aspect);
+/// Whether file scenes would walk through this model (world-space soup) or orbit it
+/// (chooseFileCamera: elongated and enclosing). Copies the mesh; O(triangles x 96 rays).
+bool staticModelWalkthrough(const Mesh& soup);
+inline constexpr std::uint32_t kStaticModelFrames = 240;
+
 /// Where generated scenes (power plant, city) cache their meshes and local BSPs.
 struct SceneCacheOptions {
     std::string dir;       ///< empty: $DYNCULL_CACHE, else out/cache
@@ -103,6 +113,16 @@ std::unique_ptr<DemoScene> makeCity(const CityOptions& options);
 /// object each, with an automatic camera (e.g. the UNC Power Plant's PLY parts).
 std::unique_ptr<DemoScene> makeSceneDir(const std::string& dir);
 
+/// Subdividing a static scene into objects on the fly (`--subdivide METHOD`); see
+/// dyncull/bsp/subdivision.hpp for the methods.
+struct SubdivideOptions {
+    std::string method;  ///< phbvo, dbvs, octree or grid; empty: no subdivision
+    std::uint32_t maxTriangles = SubdivisionParams{}.maxLeafTriangles;  ///< per leaf (object)
+    std::uint32_t maxDepth = SubdivisionParams{}.maxDepth;
+    std::uint32_t collapseTo = 0;  ///< > 0: at most this many children per node (4: quad tree)
+    unsigned threads = 2;
+};
+
 /// Options of every built-in scene, for makeScene.
 struct SceneOptions {
     BunnySwarmOptions bunny;
@@ -110,7 +130,34 @@ struct SceneOptions {
     CityOptions city;
     SceneCacheOptions cache;  ///< copied into plant and city by makeScene
     std::string sceneDir;     ///< "powerplant" with a directory: load its PLY/OBJ parts instead
+    SubdivideOptions subdivide;  ///< method set: static scenes are subdivided into objects
 };
+
+/// A static scene source as one triangle soup (instances applied): "powerplant" or "city"
+/// (generated with `options`, every object merged), a directory of parts, or a model file.
+/// `sourceHash` is the generator parameter hash of a built-in source, 0 for files.
+struct StaticSoup {
+    Mesh mesh;  ///< world space
+    std::string source;
+    std::uint64_t sourceHash = 0;
+};
+Expected<StaticSoup> loadStaticSoup(const std::string& nameOrPath, const SceneOptions& options);
+
+/// Checks and converts SubdivideOptions (method name, ranges) to subdivision parameters.
+Expected<SubdivisionParams> toSubdivisionParams(const SubdivideOptions& options);
+
+/// Loads the soup of `nameOrPath` and subdivides it (triangle order applied to the mesh),
+/// ready for writeSubdivisionFile or a SubdividedScene.
+Expected<SubdividedModel> subdivideStaticScene(const std::string& nameOrPath, const SceneOptions& options);
+
+/// A static scene subdivided into objects by options.subdivide on the fly: every leaf one
+/// static object of the global loose BSP; the camera path is the source's own (built-in
+/// scenes) or the automatic one of file scenes. Named "<source>_<method>".
+std::unique_ptr<DemoScene> makeSubdividedScene(const std::string& nameOrPath, const SceneOptions& options);
+
+/// The same from a file written by `dyncull subdivide` (.dsub). A built-in source's
+/// camera needs the generator options the file was made with: others are an error.
+std::unique_ptr<DemoScene> makeSubdivisionFileScene(const std::string& path, const SceneOptions& options);
 
 /// Resolves a scene argument: "bunnies", "powerplant", "city", a directory of PLY/OBJ
 /// parts, or a model file.

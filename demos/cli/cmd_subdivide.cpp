@@ -1,0 +1,122 @@
+// `dyncull subdivide SOURCE --method phbvo|dbvs|octree|grid --max-tris N --out FILE`:
+// cuts a static model (a model file, a directory of parts, or the power plant / city
+// merged into one soup) into subdivision entities and saves it for `dyncull run/bench
+// FILE`. Prints the tree's size, the build time and the memory used while subdividing.
+// Paper: Scene subdivision for occlusion culling, section 3.
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+
+#include "cli_util.hpp"
+#include "commands.hpp"
+#include "dyncull/bsp/subdivision_file.hpp"
+#include "dyncull/demos/demo_scene.hpp"
+#include "scene_options.hpp"
+
+namespace dyncull::cli {
+namespace {
+
+struct SubdivideCommandOptions {
+    std::string source;
+    std::string out;
+    SceneOptions sceneOptions;
+};
+
+/// A "VmRSS"/"VmHWM" line of /proc/self/status in bytes, or 0 where there is none (not Linux).
+std::size_t procStatusBytes(const char* key) {
+    std::ifstream f("/proc/self/status");
+    std::string line;
+    while (std::getline(f, line))
+        if (line.rfind(key, 0) == 0) return std::stoull(line.substr(std::string(key).size() + 1)) * 1024;
+    return 0;
+}
+
+/// Resets the peak resident size (VmHWM) to the current one (Linux >= 4.0); false if unavailable.
+bool resetPeakRss() {
+    std::ofstream f("/proc/self/clear_refs");
+    f << "5";
+    return static_cast<bool>(f);
+}
+
+double mb(std::size_t bytes) { return static_cast<double>(bytes) / (1024.0 * 1024.0); }
+
+void runSubdivide(const SubdivideCommandOptions& o) {
+    auto params = toSubdivisionParams(o.sceneOptions.subdivide);
+    if (!params) fail(params.error().message);
+    Stopwatch sw;
+    auto soup = loadStaticSoup(o.source, o.sceneOptions);
+    if (!soup) fail(soup.error().message);
+    const Mesh& mesh = soup->mesh;
+    const std::size_t meshBytes = mesh.positions.size() * sizeof(glm::vec3) + mesh.normals.size() * sizeof(glm::vec3) +
+                                  mesh.indices.size() * sizeof(std::uint32_t);
+    std::printf("%s: %zu triangles, %zu vertices, mesh %.1f MB, loaded in %.1f s\n", o.source.c_str(),
+                mesh.triangleCount(), mesh.vertexCount(), mb(meshBytes), sw.lap() / 1000.0);
+    std::fflush(stdout);
+    const std::size_t rssBefore = procStatusBytes("VmRSS:");
+    const bool peakReset = resetPeakRss();
+
+    SubdividedModel model;
+    model.mesh = std::move(soup->mesh);
+    model.source = soup->source;
+    model.sourceHash = soup->sourceHash;
+    model.params = *params;
+    auto sub = subdivide(model.mesh, model.params);
+    if (!sub) fail(o.source + ": " + sub.error().message);
+    model.subdivision = sub.take();
+    const double subdivideMs = sw.lap();
+    const std::size_t peak = procStatusBytes("VmHWM:");
+    applyTriangleOrder(model.mesh, model.subdivision);
+    const SubdivisionStats& s = model.subdivision.stats;
+    std::printf("%s: %u nodes (%u inner, %u leaves), deepest leaf %u, largest leaf %u triangles (%u above the limit), "
+                "at most %u children per node\n",
+                toString(params->method), s.nodes, s.inner, s.leaves, s.depth, s.largestLeaf, s.oversizedLeaves,
+                s.maxChildren);
+    std::printf("time: %.2f s subdividing on %u threads\n", subdivideMs / 1000.0, params->threads);
+    std::printf("memory: work arrays %.1f MB (%.2fx the mesh)", mb(s.workBytes),
+                static_cast<double>(s.workBytes) / static_cast<double>(std::max<std::size_t>(meshBytes, 1)));
+    if (peakReset && peak >= rssBefore) {
+        // The process held more than the mesh before (code, loader leftovers); what
+        // subdividing costs is the mesh plus the growth of the resident set.
+        const std::size_t added = peak - rssBefore;
+        std::printf("; resident %.1f MB before, peak %.1f MB while subdividing: mesh + %.1f MB = %.2fx the mesh",
+                    mb(rssBefore), mb(peak), mb(added),
+                    static_cast<double>(meshBytes + added) / static_cast<double>(std::max<std::size_t>(meshBytes, 1)));
+    }
+    std::printf("\n");
+    if (Status st = ensureParentDirectory(o.out); !st) fail(st.message());
+    if (Status st = writeSubdivisionFile(o.out, model); !st) fail(st.message());
+    std::error_code ec;
+    const auto bytes = std::filesystem::file_size(o.out, ec);
+    std::printf("wrote %s (%.1f MB) in %.1f s\n", o.out.c_str(), ec ? 0.0 : mb(bytes), sw.lap() / 1000.0);
+}
+
+}  // namespace
+
+void registerSubdivide(CLI::App& app) {
+    auto o = std::make_shared<SubdivideCommandOptions>();
+    o->sceneOptions.subdivide.method = "phbvo";
+    CLI::App* cmd = app.add_subcommand(
+        "subdivide", "Cut a static model into objects (p-HBVO, D-BVS, octrees) and save it for run/bench");
+    cmd->add_option("source", o->source, "a model file, a directory of .ply/.obj parts, or powerplant / city (merged into one soup)")
+        ->required();
+    cmd->add_option("--out", o->out, "output file (.dsub), read by `dyncull run/bench FILE`")->required();
+    SubdivideOptions& s = o->sceneOptions.subdivide;
+    cmd->add_option("--method", s.method, "phbvo, dbvs, octree (load-balanced) or grid (regular octree)")->capture_default_str();
+    cmd->add_option("--max-tris", s.maxTriangles, "maximum triangles per leaf (object)")->capture_default_str();
+    cmd->add_option("--max-depth", s.maxDepth, "maximum subdivision depth")->capture_default_str();
+    cmd->add_option("--collapse", s.collapseTo, "collapse to at most this many children per node (4: quad tree; 0 keeps the tree)")
+        ->capture_default_str();
+    cmd->add_option("--threads", s.threads, "worker threads (the result does not depend on it)")->capture_default_str();
+    cmd->add_option("--plant-seed", o->sceneOptions.plant.seed, "powerplant: generator seed")->capture_default_str();
+    cmd->add_option("--plant-size", o->sceneOptions.plant.size, "powerplant: fraction of the objects, (0, 1]")->capture_default_str();
+    cmd->add_option("--plant-detail", o->sceneOptions.plant.detail, "powerplant: tessellation factor, (0, 1]")->capture_default_str();
+    cmd->add_option("--city-seed", o->sceneOptions.city.seed, "city: generator seed")->capture_default_str();
+    cmd->add_option_function<std::uint32_t>(
+        "--city-blocks", [o](const std::uint32_t& n) { o->sceneOptions.city.blocksX = o->sceneOptions.city.blocksZ = n; },
+        "city: blocks along each axis (default 20)");
+    cmd->callback([o] { runSubdivide(*o); });
+}
+
+}  // namespace dyncull::cli
