@@ -107,6 +107,14 @@ Expected<std::unique_ptr<DemoScene>> makeScene(const std::string& nameOrPath, co
 }
 
 Expected<std::unique_ptr<DemoScene>> makeScene(const std::string& nameOrPath, const SceneOptions& options) {
+    // Before the built-in names: --subdivide applies to the power plant and the city too.
+    if (std::filesystem::path(nameOrPath).extension() == ".dsub") return makeSubdivisionFileScene(nameOrPath, options);
+    if (!options.subdivide.method.empty()) {
+        if (nameOrPath == "bunnies") return Error{"--subdivide: the bunny swarm is dynamic; subdivide a static scene"};
+        if (!std::filesystem::exists(nameOrPath) && nameOrPath != "powerplant" && nameOrPath != "city")
+            return Error{nameOrPath + ": not a built-in scene and no such file"};
+        return makeSubdividedScene(nameOrPath, options);
+    }
     if (nameOrPath == "bunnies") return makeBunnySwarm(options.bunny);
     if (nameOrPath == "powerplant" && !options.sceneDir.empty()) {
         if (!std::filesystem::is_directory(options.sceneDir)) return Error{options.sceneDir + ": --scene-dir is not a directory"};
@@ -121,13 +129,6 @@ Expected<std::unique_ptr<DemoScene>> makeScene(const std::string& nameOrPath, co
         CityOptions city = options.city;
         city.cache = options.cache;
         return makeCity(city);
-    }
-    if (std::filesystem::path(nameOrPath).extension() == ".dsub") return makeSubdivisionFileScene(nameOrPath, options);
-    if (!options.subdivide.method.empty()) {
-        if (nameOrPath == "bunnies") return Error{"--subdivide: the bunny swarm is dynamic; subdivide a static scene"};
-        if (!std::filesystem::exists(nameOrPath) && nameOrPath != "powerplant" && nameOrPath != "city")
-            return Error{nameOrPath + ": not a built-in scene and no such file"};
-        return makeSubdividedScene(nameOrPath, options);
     }
     if (std::filesystem::is_directory(nameOrPath)) return makeSceneDir(nameOrPath);
     if (std::filesystem::exists(nameOrPath)) return makeFileScene(nameOrPath);
