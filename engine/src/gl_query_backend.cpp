@@ -89,6 +89,11 @@ void GlQueryBackend::beginBatch() {
     // LEQUAL: a volume face coplanar with drawn geometry counts as visible (conservative).
     glDepthFunc(GL_LEQUAL);
     glDisable(GL_CULL_FACE);
+    // Pull volumes toward the eye by a few depth-buffer steps (scaled by GL to the face's
+    // depth slope and the buffer's resolution): a part lying on its box face, or a
+    // coplanar occluder, must not win a depth tie against the volume and hide a visible pixel.
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    glPolygonOffset(-1.0f, -4.0f);
     glUseProgram(program_);
     glUniformMatrix4fv(locViewProj_, 1, GL_FALSE, glm::value_ptr(viewProj_));
     glBindVertexArray(vao_);
@@ -138,6 +143,7 @@ void GlQueryBackend::endBatch() {
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glDepthMask(GL_TRUE);
     glDepthFunc(static_cast<GLenum>(savedDepthFunc_));
+    glDisable(GL_POLYGON_OFFSET_FILL);
     if (savedCull_) glEnable(GL_CULL_FACE);
     if (!savedDepthTest_) glDisable(GL_DEPTH_TEST);
     // Submit now so the rasteriser works on the queries while the CPU traverses on.
