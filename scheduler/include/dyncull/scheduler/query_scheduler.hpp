@@ -44,7 +44,10 @@ struct SchedulerParams {
     /// because shrinking its boxes was costly; transforming 8 corners is not, so the
     /// default tightens at once, moving objects included.
     std::uint32_t tightenAfterFrames = 0;
-    double queryTimeoutMs = 250.0;  ///< a result that never arrives counts as visible
+    /// A result that has not arrived after this long counts as visible (never cull, never
+    /// stall forever). Generous because a query answers only after everything submitted
+    /// before it is rasterised, which on a loaded software rasteriser can take a second.
+    double queryTimeoutMs = 2000.0;
     /// Simple and Full: the nodes met first in front-to-back order are drawn without a
     /// query until this percentage of the leaves inside the frustum has been reached (the
     /// front-most leaves are rarely occluded: k-DOP bounding volumes for occlusion, section
