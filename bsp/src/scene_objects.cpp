@@ -18,6 +18,8 @@ std::string handleText(ObjectHandle h) {
 
 ModelId SceneObjects::addModel(LocalBsp bsp) {
     assert(!bsp.nodes.empty() && "a LocalBsp always has a root node");
+    // Cache-loaded or hand-made trees arrive without volumes; every model has them after this.
+    if (bsp.volumes.nodeCount() != bsp.nodes.size()) bsp.volumes = buildNodeVolumes(bsp.mesh, bsp.nodes);
     models_.push_back(std::make_unique<LocalBsp>(std::move(bsp)));
     return static_cast<ModelId>(models_.size() - 1);
 }

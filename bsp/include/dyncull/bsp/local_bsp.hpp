@@ -8,6 +8,7 @@
 #include <limits>
 #include <vector>
 
+#include "dyncull/bsp/node_volumes.hpp"
 #include "dyncull/objects/aabb.hpp"
 #include "dyncull/objects/error.hpp"
 #include "dyncull/objects/mesh.hpp"
@@ -64,7 +65,7 @@ struct LocalBspStats {
     /// made progress, i.e. gave both children fewer triangles than the node (degenerate
     /// input: identical, stacked or mostly-cut triangles).
     std::uint32_t stalledLeaves = 0;
-    double buildMs = 0.0;
+    double buildMs = 0.0;  ///< including the node volumes
 };
 
 /// The split mesh and its tree. Owns both. A mesh at or below maxLeafTriangles gets a
@@ -72,6 +73,9 @@ struct LocalBspStats {
 struct LocalBsp {
     Mesh mesh;  ///< the input re-triangulated along split planes, indices ordered by leaf
     std::vector<LocalBspNode> nodes;  ///< nodes[0] is the root
+    /// Each node's query volumes (object space), indexed like `nodes`. Filled by
+    /// buildLocalBsp; a hand-made or cache-loaded LocalBsp gets them in SceneObjects::addModel.
+    NodeVolumes volumes;
     LocalBspStats stats;
 
     const LocalBspNode& root() const { return nodes[0]; }
@@ -83,6 +87,7 @@ struct LocalBsp {
 /// where edges cross split planes (normals interpolated, or computed first when the input
 /// has none), and indices reordered by leaf. Splitting stops at maxLeafTriangles, at
 /// maxDepth, or when no plane gives both children fewer triangles (stats.stalledLeaves).
+/// Every node's query volumes are computed too (buildNodeVolumes).
 /// Errors (never asserts) for an invalid mesh (validateMesh) or parameters:
 /// maxLeafTriangles == 0, maxDepth > kLocalBspMaxDepth, nudgeFraction not in [0, 0.5].
 /// An empty mesh gives a single empty leaf.

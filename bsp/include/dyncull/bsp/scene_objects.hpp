@@ -29,7 +29,8 @@ using ModelId = std::uint32_t;
 /// generation is bumped so stale handles are detected.
 class SceneObjects {
 public:
-    /// Takes ownership of a built local BSP; returns its id for addObject.
+    /// Takes ownership of a built local BSP; returns its id for addObject. Computes the
+    /// nodes' query volumes when the BSP has none (e.g. loaded from a cache).
     ModelId addModel(LocalBsp bsp);
     const LocalBsp& model(ModelId id) const { return *models_[id]; }
     std::size_t modelCount() const { return models_.size(); }
