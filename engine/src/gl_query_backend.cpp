@@ -1,9 +1,12 @@
 // GL occlusion-query backend. Paper: Two-level BSP for dynamic occlusion culling,
-// section 3.4 (queries on node boxes, several in flight at once).
+// section 3.4 (queries on node boxes, several in flight at once); k-DOP query meshes per
+// kdop-bounding-volumes-for-occlusion.txt, section 4 (bounding volume drawn with depth
+// and colour writes off).
 #include "dyncull/engine/gl_query_backend.hpp"
 
 #include <cassert>
 #include <chrono>
+#include <cstdint>
 #include <cstring>
 #include <string>
 #include <thread>
@@ -12,6 +15,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "dyncull/engine/gl_context.hpp"
+#include "dyncull/objects/convex_mesh.hpp"
 #include "shader_program.hpp"
 
 namespace dyncull {
@@ -26,19 +30,10 @@ const char* const kVolumeFs = R"(#version 450 core
 void main() {}
 )";
 
-// 12 triangles of a box whose corner i has x from bit 0, y from bit 1, z from bit 2.
-// Winding does not matter: face culling is off so a volume seen from inside or from any
-// side still rasterises.
-const std::uint8_t kBoxIndices[36] = {
-    0, 2, 1, 1, 2, 3,  // z = min
-    4, 5, 6, 5, 7, 6,  // z = max
-    0, 1, 4, 1, 5, 4,  // y = min
-    2, 6, 3, 3, 6, 7,  // y = max
-    0, 4, 2, 2, 4, 6,  // x = min
-    1, 3, 5, 3, 7, 5,  // x = max
-};
-
-constexpr std::uint32_t kInitialVolumes = 4096;
+// Streaming capacity at start (grows by doubling): vertices for 4096 boxes, and 8-bit
+// indices for 1024 k-DOPs of up to 92 triangles.
+constexpr std::uint32_t kInitialVertices = 4096 * 8;
+constexpr std::uint32_t kInitialIndices = 1024 * 3 * QueryVolume::kMaxTriangles;
 
 }  // namespace
 
@@ -48,33 +43,45 @@ Expected<std::unique_ptr<GlQueryBackend>> GlQueryBackend::create(GlContext& cont
     b->program_ = detail::buildProgram(kVolumeVs, kVolumeFs, log);
     if (!b->program_) return Error{"query volume shader: " + log};
     b->locViewProj_ = glGetUniformLocation(b->program_, "uViewProj");
-    glCreateBuffers(1, &b->ibo_);
-    glNamedBufferStorage(b->ibo_, sizeof(kBoxIndices), kBoxIndices, 0);
+    // Boxes index a static 36-byte buffer; meshes stream their own indices. Two vertex
+    // arrays over the same vertex stream, so the box path stays one upload and one draw.
+    glCreateBuffers(1, &b->boxIbo_);
+    glNamedBufferStorage(b->boxIbo_, sizeof(kBoxTriangles), kBoxTriangles.data(), 0);
+    glCreateBuffers(1, &b->meshIbo_);
+    b->iboCapacity_ = kInitialIndices;
+    glNamedBufferData(b->meshIbo_, b->iboCapacity_, nullptr, GL_STREAM_DRAW);
     glCreateBuffers(1, &b->vbo_);
-    b->vboCapacity_ = kInitialVolumes;
-    glNamedBufferData(b->vbo_, b->vboCapacity_ * 8 * sizeof(glm::vec3), nullptr, GL_STREAM_DRAW);
-    glCreateVertexArrays(1, &b->vao_);
-    glVertexArrayVertexBuffer(b->vao_, 0, b->vbo_, 0, sizeof(glm::vec3));
-    glVertexArrayElementBuffer(b->vao_, b->ibo_);
-    glEnableVertexArrayAttrib(b->vao_, 0);
-    glVertexArrayAttribFormat(b->vao_, 0, 3, GL_FLOAT, GL_FALSE, 0);
-    glVertexArrayAttribBinding(b->vao_, 0, 0);
+    b->vboCapacity_ = kInitialVertices;
+    glNamedBufferData(b->vbo_, b->vboCapacity_ * sizeof(glm::vec3), nullptr, GL_STREAM_DRAW);
+    glCreateVertexArrays(1, &b->boxVao_);
+    glCreateVertexArrays(1, &b->meshVao_);
+    for (std::uint32_t vao : {b->boxVao_, b->meshVao_}) {
+        glVertexArrayVertexBuffer(vao, 0, b->vbo_, 0, sizeof(glm::vec3));
+        glVertexArrayElementBuffer(vao, vao == b->boxVao_ ? b->boxIbo_ : b->meshIbo_);
+        glEnableVertexArrayAttrib(vao, 0);
+        glVertexArrayAttribFormat(vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
+        glVertexArrayAttribBinding(vao, 0, 0);
+    }
     return b;
 }
 
 GlQueryBackend::~GlQueryBackend() {
     for (Slot& s : queries_) glDeleteQueries(1, &s.name);
-    glDeleteVertexArrays(1, &vao_);
+    glDeleteVertexArrays(1, &boxVao_);
+    glDeleteVertexArrays(1, &meshVao_);
     glDeleteBuffers(1, &vbo_);
-    glDeleteBuffers(1, &ibo_);
+    glDeleteBuffers(1, &boxIbo_);
+    glDeleteBuffers(1, &meshIbo_);
     if (program_) glDeleteProgram(program_);
 }
 
 void GlQueryBackend::beginFrame(const Camera& camera, int, int) {
     viewProj_ = camera.viewProjection();
     // Orphan last frame's volumes so writing this frame's never waits on the rasteriser.
-    glNamedBufferData(vbo_, vboCapacity_ * 8 * sizeof(glm::vec3), nullptr, GL_STREAM_DRAW);
+    glNamedBufferData(vbo_, vboCapacity_ * sizeof(glm::vec3), nullptr, GL_STREAM_DRAW);
     vboUsed_ = 0;
+    if (iboUsed_ > 0) glNamedBufferData(meshIbo_, iboCapacity_, nullptr, GL_STREAM_DRAW);
+    iboUsed_ = 0;
 }
 
 void GlQueryBackend::beginBatch() {
@@ -96,18 +103,32 @@ void GlQueryBackend::beginBatch() {
     glPolygonOffset(-1.0f, -4.0f);
     glUseProgram(program_);
     glUniformMatrix4fv(locViewProj_, 1, GL_FALSE, glm::value_ptr(viewProj_));
-    glBindVertexArray(vao_);
+    glBindVertexArray(boxVao_);
+    boundMesh_ = false;
 }
 
 QueryId GlQueryBackend::issue(const QueryVolume& volume) {
     assert(inBatch_);
-    if (vboUsed_ == vboCapacity_) {
+    assert(volume.vertexCount <= QueryVolume::kMaxVertices && volume.triangleCount <= QueryVolume::kMaxTriangles);
+    assert(!volume.isBox() || volume.vertexCount == 8);
+    const std::uint32_t nv = volume.vertexCount, ni = 3 * volume.triangleCount;
+    if (vboUsed_ + nv > vboCapacity_) {
         // Grow: earlier draws of this frame keep the orphaned storage they referenced.
         vboCapacity_ *= 2;
-        glNamedBufferData(vbo_, vboCapacity_ * 8 * sizeof(glm::vec3), nullptr, GL_STREAM_DRAW);
+        glNamedBufferData(vbo_, vboCapacity_ * sizeof(glm::vec3), nullptr, GL_STREAM_DRAW);
         vboUsed_ = 0;
     }
-    glNamedBufferSubData(vbo_, vboUsed_ * 8 * sizeof(glm::vec3), 8 * sizeof(glm::vec3), volume.corners.data());
+    if (iboUsed_ + ni > iboCapacity_) {
+        iboCapacity_ *= 2;
+        glNamedBufferData(meshIbo_, iboCapacity_, nullptr, GL_STREAM_DRAW);
+        iboUsed_ = 0;
+    }
+    glNamedBufferSubData(vbo_, vboUsed_ * sizeof(glm::vec3), nv * sizeof(glm::vec3), volume.vertices.data());
+    if (!volume.isBox()) glNamedBufferSubData(meshIbo_, iboUsed_, ni, volume.indices.data());
+    if (boundMesh_ != !volume.isBox()) {
+        boundMesh_ = !volume.isBox();
+        glBindVertexArray(boundMesh_ ? meshVao_ : boxVao_);
+    }
 
     QueryId id;
     if (!free_.empty()) {
@@ -131,9 +152,16 @@ QueryId GlQueryBackend::issue(const QueryVolume& volume) {
     s.result = QueryResult::NotReady;
     s.samples = 0;
     glBeginQuery(target, s.name);
-    glDrawElementsBaseVertex(GL_TRIANGLES, 36, GL_UNSIGNED_BYTE, nullptr, static_cast<GLint>(vboUsed_ * 8));
+    if (volume.isBox()) {
+        glDrawElementsBaseVertex(GL_TRIANGLES, 36, GL_UNSIGNED_BYTE, nullptr, static_cast<GLint>(vboUsed_));
+    } else {
+        glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(ni), GL_UNSIGNED_BYTE,
+                                 reinterpret_cast<const void*>(static_cast<std::uintptr_t>(iboUsed_)),
+                                 static_cast<GLint>(vboUsed_));
+        iboUsed_ += ni;
+    }
     glEndQuery(target);
-    ++vboUsed_;
+    vboUsed_ += nv;
     return id;
 }
 

@@ -55,6 +55,8 @@ Status validateSchedulerParams(const SchedulerParams& p) {
     if (!(p.queryTimeoutMs > 0.0)) return Error{"queryTimeoutMs must be positive"};
     if (p.history.maxSkipFrames > 1000) return Error{"history.maxSkipFrames must be at most 1000"};
     if (!(p.frontPercent >= 0.0f && p.frontPercent <= 100.0f)) return Error{"frontPercent must be in [0, 100]"};
+    if (!(p.autoVolumeSaving >= 0.0f && p.autoVolumeSaving <= 1.0f)) return Error{"autoVolumeSaving must be in [0, 1]"};
+    if (static_cast<int>(p.volume) > static_cast<int>(VolumeChoice::Auto)) return Error{"volume has an unknown value"};
     return {};
 }
 
@@ -122,6 +124,7 @@ void QueryScheduler::timedEndBatch() {
 }
 
 QueryId QueryScheduler::timedIssue(const QueryVolume& volume) {
+    stats_->queryTriangles += volume.isBox() ? 12u : volume.triangleCount;
     const auto t0 = Clock::now();
     const QueryId id = backend_->issue(volume);
     stats_->queryMs += msSince(t0);
@@ -233,11 +236,18 @@ QueryScheduler::FirstTest QueryScheduler::firstVisibilityTest(NodeRef ref, const
 
 QueryVolume QueryScheduler::queryVolume(NodeRef ref, const Aabb& worldBox) const {
     if (ref.isSceneNode() || params_.mode != CullMode::Full || !params_.useTightVolumes) return QueryVolume::fromAabb(worldBox);
-    // Tightened box: the object's exact transformed local box instead of its world AABB,
-    // once the object has kept its transform for a few frames.
+    // Tightened volume: the node's own object-space volume under the object's matrix
+    // instead of its world AABB, once the object has kept its transform for a few frames.
     if (frame_ - stillSince_[ref.object] < params_.tightenAfterFrames) return QueryVolume::fromAabb(worldBox);
     const SceneObjects& objs = tree_->objects();
-    return QueryVolume::fromTransformedBox(objs.matrix(ref.object), objs.model(objs.modelOf(ref.object)).nodes[ref.node].box);
+    const LocalBsp& model = objs.model(objs.modelOf(ref.object));
+    const glm::mat4& m = objs.matrix(ref.object);
+    if (params_.volume == VolumeChoice::Aabb || model.volumes.nodeCount() != model.nodes.size())
+        return QueryVolume::fromTransformedBox(m, model.nodes[ref.node].box);
+    const VolumeKind kind = chooseVolume(model.volumes, ref.node, params_.volume, params_.autoVolumeSaving);
+    const NodeVolume& v = model.volumes.get(ref.node, kind);
+    if (v.vertexCount == 0) return QueryVolume::fromAabb(worldBox);  // empty node: never reached in practice
+    return QueryVolume::fromNodeVolume(m, model.volumes, v);
 }
 
 void QueryScheduler::drawNode(NodeRef ref) {

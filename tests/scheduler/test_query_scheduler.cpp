@@ -4,10 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <functional>
 #include <map>
 #include <set>
 
+#include "dyncull/bsp/local_bsp.hpp"
 #include "dyncull/bsp/loose_bsp.hpp"
 #include "dyncull/bsp/scene_objects.hpp"
 #include "dyncull/bsp/traversal.hpp"
@@ -258,7 +260,7 @@ TEST(QueryScheduler, BatchesHoldOnlyNonOverlappingRectangles) {
     // one batch are in flight together.
     auto tilesOf = [&](const QueryVolume& v) {
         glm::vec2 lo(1e9f), hi(-1e9f);
-        for (const glm::vec3& c : v.corners) {
+        for (const glm::vec3& c : v.points()) {
             const glm::vec4 cl = vp * glm::vec4(c, 1.0f);
             const glm::vec2 px = (glm::vec2(cl) / cl.w + 1.0f) * 0.5f * glm::vec2(640, 320);
             lo = glm::min(lo, px);
@@ -334,4 +336,113 @@ TEST(QueryScheduler, FrontMostLeavesAreDrawnWithoutQueries) {
     SchedulerParams bad;
     bad.frontPercent = 150.0f;
     EXPECT_FALSE(validateSchedulerParams(bad));
+}
+
+namespace {
+
+// A rotated lumpy sphere split into a few parts, instanced on a grid in front of the camera.
+Mesh lumpySphere() {
+    Mesh m;
+    const int slices = 40, stacks = 24;
+    for (int j = 0; j <= stacks; ++j) {
+        const float phi = 3.14159265f * float(j) / float(stacks);
+        for (int i = 0; i < slices; ++i) {
+            const float th = 6.2831853f * float(i) / float(slices);
+            const float r = 0.4f * (1.0f + 0.2f * std::sin(3.0f * phi) * std::cos(4.0f * th));
+            m.positions.push_back(r * glm::vec3(std::sin(phi) * std::cos(th), 0.7f * std::cos(phi), std::sin(phi) * std::sin(th)));
+        }
+    }
+    for (int j = 0; j < stacks; ++j)
+        for (int i = 0; i < slices; ++i) {
+            const auto a = std::uint32_t(j * slices + i), b = std::uint32_t(j * slices + (i + 1) % slices);
+            const auto c = a + std::uint32_t(slices), d = b + std::uint32_t(slices);
+            if (j > 0) m.indices.insert(m.indices.end(), {a, b, c});
+            if (j + 1 < stacks) m.indices.insert(m.indices.end(), {b, d, c});
+        }
+    return m;
+}
+
+}  // namespace
+
+TEST(QueryScheduler, ObjectNodesAreQueriedWithTheChosenVolume) {
+    SceneObjects objects;
+    LocalBspParams lp;
+    lp.maxLeafTriangles = 400;
+    const ModelId model = objects.addModel(buildLocalBsp(lumpySphere(), lp).take());
+    ASSERT_GT(objects.model(model).nodes.size(), 3u);
+    for (int i = 0; i < 12; ++i) {
+        Transform t;
+        t.translation = {float(i % 4) - 1.5f, float(i / 4) - 1.0f, -4.0f - 0.5f * float(i)};
+        t.rotation = glm::angleAxis(0.3f * float(i), glm::normalize(glm::vec3(1, 2, 0.5f)));
+        t.scale = {1.0f + 0.1f * float(i % 3), 0.8f, 1.2f};
+        objects.addObject(model, t).take();
+    }
+    LooseBsp bsp;
+    bsp.build(objects);
+    TwoLevelTree tree(bsp, objects);
+    for (VolumeChoice c : {VolumeChoice::Aabb, VolumeChoice::Obb, VolumeChoice::Kdop14, VolumeChoice::Kdop18,
+                           VolumeChoice::Kdop26, VolumeChoice::Auto}) {
+        SCOPED_TRACE(toString(c));
+        ScriptedBackend b;
+        SchedulerParams p;
+        p.useOccupancyAccept = false;  // force queries
+        p.useHistory = false;
+        p.volume = c;
+        QueryScheduler sched(p);
+        RecordingSink sink;
+        const FrameStats st = sched.cullFrame(tree, frontCamera(), 640, 320, b, sink);
+        std::uint64_t triangles = 0;
+        std::uint32_t meshes = 0, boxes = 0;
+        for (const auto& q : b.queries) {
+            triangles += q.v.isBox() ? 12u : q.v.triangleCount;
+            (q.v.isBox() ? boxes : meshes) += 1;
+            EXPECT_LE(q.v.triangleCount, QueryVolume::kMaxTriangles);
+            EXPECT_EQ(q.v.isBox() ? 8u : q.v.triangles().size() / 3, q.v.isBox() ? q.v.vertexCount : q.v.triangleCount);
+        }
+        EXPECT_EQ(st.queryTriangles, triangles);
+        EXPECT_GT(boxes, 0u);  // scene nodes are always world boxes
+        if (c == VolumeChoice::Aabb || c == VolumeChoice::Obb) EXPECT_EQ(meshes, 0u);
+        else EXPECT_GT(meshes, 0u);
+    }
+    // Simple and the untightened ablation query world boxes only.
+    for (bool simple : {true, false}) {
+        ScriptedBackend b;
+        SchedulerParams p;
+        p.mode = simple ? CullMode::Simple : CullMode::Full;
+        p.useTightVolumes = simple;
+        p.useOccupancyAccept = false;
+        p.volume = VolumeChoice::Kdop26;
+        QueryScheduler sched(p);
+        RecordingSink sink;
+        sched.cullFrame(tree, frontCamera(), 640, 320, b, sink);
+        EXPECT_GT(b.queries.size(), 0u);
+        for (const auto& q : b.queries) EXPECT_TRUE(q.v.isBox());
+    }
+}
+
+TEST(QueryVolume, NodeVolumesAreTransformedVertexByVertex) {
+    LocalBspParams lp;
+    lp.maxLeafTriangles = 400;
+    const LocalBsp bsp = buildLocalBsp(lumpySphere(), lp).take();
+    Transform t;
+    t.translation = {3, -1, 2};
+    t.rotation = glm::angleAxis(1.0f, glm::normalize(glm::vec3(0.2f, 1, -0.4f)));
+    t.scale = {2.0f, 0.5f, 1.0f};
+    const glm::mat4 m = t.matrix();
+    for (std::uint32_t n = 0; n < bsp.nodes.size(); ++n)
+        for (VolumeKind k : {VolumeKind::Aabb, VolumeKind::Obb, VolumeKind::Kdop14, VolumeKind::Kdop18, VolumeKind::Kdop26}) {
+            const NodeVolume& e = bsp.volumes.get(n, k);
+            const QueryVolume q = QueryVolume::fromNodeVolume(m, bsp.volumes, e);
+            ASSERT_EQ(q.vertexCount, e.vertexCount);
+            ASSERT_EQ(q.isBox(), e.isBox());
+            const auto src = bsp.volumes.verticesOf(e);
+            for (std::uint32_t i = 0; i < q.vertexCount; ++i) EXPECT_EQ(q.vertices[i], glm::vec3(m * glm::vec4(src[i], 1.0f)));
+            const auto tri = q.triangles();
+            if (e.isBox()) EXPECT_EQ(tri.size(), 36u);
+            else EXPECT_TRUE(std::equal(tri.begin(), tri.end(), bsp.volumes.indicesOf(e).begin()));
+        }
+    // The AABB kind is exactly the tightened local box of before.
+    const QueryVolume a = QueryVolume::fromNodeVolume(m, bsp.volumes, bsp.volumes.get(0, VolumeKind::Aabb));
+    const QueryVolume b = QueryVolume::fromTransformedBox(m, bsp.nodes[0].box);
+    for (int i = 0; i < 8; ++i) EXPECT_EQ(a.vertices[i], b.vertices[i]);
 }

@@ -1,5 +1,6 @@
 // Hardware occlusion queries for the scheduler: each query volume (8 world-space box
-// corners) is drawn with colour and depth writes off inside a GL query.
+// corners, or a convex mesh such as a k-DOP) is drawn with colour and depth writes off
+// inside a GL query.
 // Conservative by default (GL_ANY_SAMPLES_PASSED_CONSERVATIVE); with a visible-pixel
 // threshold N > 0 it uses GL_SAMPLES_PASSED and calls a node visible only if more than
 // N samples passed (an approximate setting: it may drop up to N pixels per node).
@@ -61,10 +62,13 @@ private:
     GlQueryParams params_;
     std::vector<Slot> queries_;
     std::vector<QueryId> free_;
-    std::uint32_t program_ = 0, vao_ = 0, vbo_ = 0, ibo_ = 0;
+    std::uint32_t program_ = 0, boxVao_ = 0, meshVao_ = 0, vbo_ = 0, boxIbo_ = 0, meshIbo_ = 0;
     int locViewProj_ = -1;
-    std::uint32_t vboCapacity_ = 0;  // volumes
-    std::uint32_t vboUsed_ = 0;      // volumes written this frame
+    std::uint32_t vboCapacity_ = 0;  // vertices
+    std::uint32_t vboUsed_ = 0;      // vertices written this frame
+    std::uint32_t iboCapacity_ = 0;  // mesh indices (bytes)
+    std::uint32_t iboUsed_ = 0;      // mesh indices written this frame
+    bool boundMesh_ = false;         // meshVao_ (not boxVao_) bound in this batch
     glm::mat4 viewProj_{1.0f};
     // State saved by beginBatch, restored by endBatch.
     int savedDepthFunc_ = 0;

@@ -13,6 +13,7 @@ struct FrameStats {
     double frameMs = 0.0;      ///< whole frame including the final glFinish
     double updateMs = 0.0;     ///< loose-BSP relink and lazy rebuild
     std::uint32_t queriesIssued = 0;
+    std::uint64_t queryTriangles = 0;   ///< triangles of the query volumes drawn (12 per box)
     std::uint32_t queriesOccluded = 0;  ///< answered "occluded"
     std::uint32_t queriesTimedOut = 0;  ///< never answered within the bound; counted visible
     std::uint32_t skippedByHistory = 0;  ///< queries not issued thanks to visibility history

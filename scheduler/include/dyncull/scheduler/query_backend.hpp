@@ -5,9 +5,11 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 
 #include <glm/glm.hpp>
 
+#include "dyncull/bsp/node_volumes.hpp"
 #include "dyncull/objects/aabb.hpp"
 #include "dyncull/objects/camera.hpp"
 
@@ -17,15 +19,35 @@ namespace dyncull {
 /// NotReady while other work is possible.
 enum class QueryResult : std::uint8_t { NotReady, Visible, Occluded };
 
-/// A convex query volume: a box given by its 8 world-space corners; corner i has
-/// x from bit 0, y from bit 1, z from bit 2 (so an AABB or a transformed local box —
-/// a parallelepiped — both fit). Drawn with colour and depth writes off.
+/// A convex query volume in world space, drawn with colour and depth writes off. Either a
+/// box — 8 corners, corner i with x from bit 0, y from bit 1, z from bit 2 (an AABB, or a
+/// transformed local box or PCA box: a parallelepiped), the fast path — or a convex
+/// triangle mesh of up to 48 vertices and 92 triangles (a k-DOP boundary). Holds its data
+/// by value (no borrowed pointers), so backends may keep copies.
 struct QueryVolume {
-    std::array<glm::vec3, 8> corners;
+    static constexpr std::uint32_t kMaxVertices = 48;
+    static constexpr std::uint32_t kMaxTriangles = 92;
+
+    std::array<glm::vec3, kMaxVertices> vertices;  ///< world space, [0, vertexCount) used
+    std::uint32_t vertexCount = 0;
+    /// 3 per triangle, into `vertices`, counter-clockwise seen from outside (backends draw
+    /// both sides anyway); [0, 3 * triangleCount) used. 0 triangles: a box.
+    std::array<std::uint8_t, 3 * kMaxTriangles> indices;
+    std::uint32_t triangleCount = 0;
+
+    bool isBox() const { return triangleCount == 0; }
+    /// The used vertices (the 8 corners of a box).
+    std::span<const glm::vec3> points() const { return {vertices.data(), vertexCount}; }
+    /// The triangles: kBoxTriangles for a box.
+    std::span<const std::uint8_t> triangles() const;
 
     static QueryVolume fromAabb(const Aabb& box);
     /// The object-space box `local` under the affine `objectToWorld` (exact, not re-bounded).
     static QueryVolume fromTransformedBox(const glm::mat4& objectToWorld, const Aabb& local);
+    /// A stored node volume (object space, `volumes` owns its data) under the affine
+    /// `objectToWorld`: vertices transformed, triangles kept (k-DOP paper, section 3.3).
+    /// An empty node volume gives an empty box (vertexCount 0) — callers query such nodes by AABB.
+    static QueryVolume fromNodeVolume(const glm::mat4& objectToWorld, const NodeVolumes& volumes, const NodeVolume& v);
 };
 
 using QueryId = std::uint32_t;

@@ -13,6 +13,7 @@
 #include "dyncull/bsp/traversal.hpp"
 #include "dyncull/objects/camera.hpp"
 #include "dyncull/objects/error.hpp"
+#include "dyncull/objects/volume_kind.hpp"
 #include "dyncull/scheduler/frame_stats.hpp"
 #include "dyncull/scheduler/occupancy_map.hpp"
 #include "dyncull/scheduler/query_backend.hpp"
@@ -44,6 +45,15 @@ struct SchedulerParams {
     /// because shrinking its boxes was costly; transforming 8 corners is not, so the
     /// default tightens at once, moving objects included.
     std::uint32_t tightenAfterFrames = 0;
+    /// What object nodes are queried with once tightened (Full with useTightVolumes):
+    /// the node's stored volume of this kind under the object's matrix. Aabb is the
+    /// transformed local box; Auto picks per node (chooseVolume in node_volumes.hpp).
+    /// Scene nodes, Simple mode and untightened objects always use world AABBs; frustum
+    /// tests, screen rectangles and the occupancy maps always use world AABBs.
+    VolumeChoice volume = VolumeChoice::Aabb;
+    /// Auto: a k-DOP replaces the node's best box only if it has at least this fraction
+    /// less surface area (in [0, 1]). Chosen by measurement: see docs/BENCHMARKS.md.
+    float autoVolumeSaving = 0.1f;
     /// A result that has not arrived after this long counts as visible (never cull, never
     /// stall forever). Generous because a query answers only after everything submitted
     /// before it is rasterised, which on a loaded software rasteriser can take a second.
@@ -89,7 +99,7 @@ struct NodeTrace {
     NodeState state;
 };
 
-/// Validates ranges (e.g. tile size > 0, maxQueriesInFlight > 0).
+/// Validates ranges (e.g. tile size > 0, maxQueriesInFlight > 0, autoVolumeSaving in [0, 1]).
 Status validateSchedulerParams(const SchedulerParams& p);
 
 /// Runs one frame of culling and drawing. Owns the visibility history between frames;
@@ -132,7 +142,7 @@ private:
 
     void timedBeginBatch();
     void timedEndBatch();
-    QueryId timedIssue(const QueryVolume& volume);
+    QueryId timedIssue(const QueryVolume& volume);  // also counts its triangles
     QueryResult timedPoll(QueryId id);
     std::uint32_t countFrustumLeaves() const;
     void runVfc();
