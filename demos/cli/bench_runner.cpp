@@ -53,7 +53,64 @@ std::string modeNamesHelp() {
            "skipN (history max skip N, 2 per visible), overlap (overlapping batches), smallN (small-feature pixels); "
            "backend: noflush (no glFlush after each batch); "
            "conservative: frontN (front-most N% of leaves drawn without queries); "
-           "ablations: full-nohist, full-nobatch, full-noocc, full-notight; settings of full combine with '+' (thr16+latency1)";
+           "ablations: full-nohist, full-nobatch, full-noocc, full-notight; settings of full combine with '+' "
+           "(thr16+latency1), including a query volume: aabb, obb, kdop14, kdop18, kdop26, auto (full+kdop26)";
+}
+
+bool queriesNodeVolumes(const ModeSpec& m) {
+    return !m.oracle && m.scheduler.mode == CullMode::Full && m.scheduler.useTightVolumes;
+}
+
+namespace {
+
+/// Whether one of the '+'-separated parts of a mode name is a volume ("full+kdop26").
+bool namesVolume(const std::string& name) {
+    std::size_t start = 0;
+    while (true) {
+        const std::size_t plus = name.find('+', start);
+        if (parseVolumeChoice(name.substr(start, plus == std::string::npos ? std::string::npos : plus - start))) return true;
+        if (plus == std::string::npos) return false;
+        start = plus + 1;
+    }
+}
+
+}  // namespace
+
+Status setVolume(std::vector<ModeSpec>& modes, const std::string& volume) {
+    auto v = parseVolumeChoice(volume);
+    if (!v) return Error{"--volume: " + v.error().message};
+    for (ModeSpec& m : modes) {
+        if (!queriesNodeVolumes(m) || namesVolume(m.name)) continue;
+        m.scheduler.volume = *v;
+    }
+    return {};
+}
+
+Expected<std::vector<ModeSpec>> withVolumes(std::vector<ModeSpec> modes, const std::string& list) {
+    std::vector<VolumeChoice> volumes;
+    for (const std::string& name : splitCommas(list)) {
+        auto v = parseVolumeChoice(name);
+        if (!v) return Error{"--volumes: " + v.error().message};
+        if (std::find(volumes.begin(), volumes.end(), *v) != volumes.end())
+            return Error{"--volumes: '" + name + "' given twice"};
+        volumes.push_back(*v);
+    }
+    std::vector<ModeSpec> out;
+    for (ModeSpec& m : modes) {
+        if (!queriesNodeVolumes(m)) {
+            out.push_back(std::move(m));
+            continue;
+        }
+        if (namesVolume(m.name))
+            return Error{"--volumes: mode '" + m.name + "' already names its volume"};
+        for (VolumeChoice v : volumes) {
+            ModeSpec c = m;
+            c.name = m.name + "+" + toString(v);
+            c.scheduler.volume = v;
+            out.push_back(std::move(c));
+        }
+    }
+    return out;
 }
 
 namespace {
@@ -102,16 +159,24 @@ Expected<ModeSpec> modeFromName(const std::string& name) {
     } else if (name == "oracle") {
         m.oracle = true;
     } else {
-        // Settings of `full` combine with '+', e.g. thr16+latency1.
+        // Settings of `full` combine with '+', e.g. thr16+latency1; at most one is a volume.
         std::size_t start = 0;
+        bool volume = false;
         while (true) {
             const std::size_t plus = name.find('+', start);
             const std::string part = name.substr(start, plus == std::string::npos ? std::string::npos : plus - start);
-            if (!applyFullSetting(part, m))
+            if (auto v = parseVolumeChoice(part)) {
+                if (volume) return Error{"--modes: '" + name + "' names two volumes"};
+                volume = true;
+                m.scheduler.volume = *v;
+            } else if (!applyFullSetting(part, m)) {
                 return Error{"--modes: unknown mode '" + part + "' in '" + name + "' (known: " + modeNamesHelp() + ")"};
+            }
             if (plus == std::string::npos) break;
             start = plus + 1;
         }
+        if (volume && !queriesNodeVolumes(m))
+            return Error{"--modes: '" + name + "': full-notight queries world boxes and takes no volume"};
     }
     if (Status s = validateSchedulerParams(m.scheduler); !s) return Error{"--modes: " + name + ": " + s.message()};
     return m;
@@ -131,7 +196,7 @@ Expected<std::vector<ModeSpec>> modesFromList(const std::string& list) {
 }
 
 std::string sweepParamsHelp() {
-    return "pixel-threshold, max-skip, skip-per-visible, small-feature, max-in-flight, tile-size";
+    return "pixel-threshold, max-skip, skip-per-visible, small-feature, max-in-flight, tile-size, auto-saving (percent)";
 }
 
 Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec) {
@@ -156,6 +221,9 @@ Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec) {
             m.scheduler.maxQueriesInFlight = v;
         } else if (param == "tile-size") {
             m.scheduler.occupancyTileSize = static_cast<int>(std::min<std::uint32_t>(v, 1u << 20));
+        } else if (param == "auto-saving") {
+            m.scheduler.volume = VolumeChoice::Auto;
+            m.scheduler.autoVolumeSaving = static_cast<float>(v) / 100.0f;
         } else {
             return Error{"--param: unknown parameter '" + param + "' (known: " + sweepParamsHelp() + ")"};
         }
@@ -252,6 +320,15 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
     return {};
 }
 
+void BenchRunner::measureLeafVolumes() {
+    result_.leafTotals.assign(result_.modes.size(), {});
+    for (std::size_t m = 0; m < result_.modes.size(); ++m) {
+        const ModeSpec& spec = result_.modes[m];
+        if (queriesNodeVolumes(spec))
+            result_.leafTotals[m] = leafVolumeTotals(engine_.objects(), spec.scheduler.volume, spec.scheduler.autoVolumeSaving);
+    }
+}
+
 }  // namespace dyncull::cli
 
 namespace dyncull::cli {
@@ -297,6 +374,7 @@ Status runMeasurement(const MeasureOptions& o, std::vector<ModeSpec> modes, cons
     }
     if ((*context)->checkErrors() != 0)
         std::fprintf(stderr, "warning: %llu GL errors\n", static_cast<unsigned long long>((*context)->glErrorCount()));
+    (*runner)->measureLeafVolumes();
 
     const BenchResult& result = (*runner)->result();
     const std::vector<ModeSummary> summary = summarise(result);

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "dyncull/bsp/volume_totals.hpp"
 #include "dyncull/demos/demo_scene.hpp"
 #include "dyncull/engine/engine.hpp"
 #include "dyncull/engine/ground_truth.hpp"
@@ -35,16 +36,29 @@ struct ModeSpec {
 /// answer), overlap (overlapping batches), smallN (small-feature culling below N pixels);
 /// frontN (conservative: the front-most N% of frustum leaves drawn without queries);
 /// ablations full-nohist, full-nobatch, full-noocc, full-notight. Settings of full combine
-/// with '+' (thr16+latency1). Error names the mode.
+/// with '+' (thr16+latency1); one of them may be a query volume (aabb, obb, kdop14, kdop18,
+/// kdop26, auto: full+kdop26, thr16+obb) for modes that query node volumes
+/// (queriesNodeVolumes). Error names the mode.
 Expected<ModeSpec> modeFromName(const std::string& name);
+/// True for modes whose queries use the nodes' stored volumes (Full with tightened
+/// volumes, not the oracle), i.e. the modes a volume choice changes.
+bool queriesNodeVolumes(const ModeSpec& m);
+/// `--volume`: every mode that queries node volumes, and whose name does not already name
+/// a volume, uses `volume` (names unchanged). Error for an unknown volume name.
+Status setVolume(std::vector<ModeSpec>& modes, const std::string& volume);
+/// `--volumes LIST`: each mode that queries node volumes becomes one mode per listed
+/// volume, named MODE+VOLUME; other modes stay once. Errors for unknown or repeated names
+/// and for modes that already name a volume.
+Expected<std::vector<ModeSpec>> withVolumes(std::vector<ModeSpec> modes, const std::string& list);
 /// A comma-separated list of names, e.g. "vfc,simple,full,oracle,thr16".
 Expected<std::vector<ModeSpec>> modesFromList(const std::string& list);
 /// Names understood by modeFromName (N stands for a number), for help texts.
 std::string modeNamesHelp();
 
 /// Sweep of one parameter of `full`: "NAME=v1,v2,..." with NAME one of pixel-threshold,
-/// max-skip, skip-per-visible, small-feature, max-in-flight, tile-size. One mode per value,
-/// named "NAME=v". Error names the bad parameter or value.
+/// max-skip, skip-per-visible, small-feature, max-in-flight, tile-size, auto-saving
+/// (percent; full with the auto volume). One mode per value, named "NAME=v". Error names
+/// the bad parameter or value.
 Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec);
 std::string sweepParamsHelp();
 
@@ -72,6 +86,9 @@ struct BenchResult {
     std::vector<ModeSpec> modes;  ///< modes[0] is vfc (the reference image)
     std::vector<FrameTruth> truth;                ///< per frame
     std::vector<std::vector<ModeFrame>> frames;   ///< frames[frame][mode]
+    /// Per mode: world-space totals of the leaf query volumes at the last frame (the
+    /// k-DOP paper's Table 5); leaves == 0 for modes that do not query node volumes.
+    std::vector<LeafVolumeTotals> leafTotals;
 };
 
 /// Borrows the engine (already populated with `scene`) and the scene for its lifetime.
@@ -82,6 +99,8 @@ public:
 
     /// Moves the scene to `frame`, computes the truth and renders every mode; appends to result().
     Status runFrame(std::uint64_t frame);
+    /// Fills result().leafTotals from the scene as it is now (call after the last frame).
+    void measureLeafVolumes();
 
     const BenchResult& result() const { return result_; }
     /// Image each mode rendered in the last frame (index as result().modes).

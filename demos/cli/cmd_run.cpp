@@ -59,6 +59,7 @@ void runRun(RunOptions o) {
     if (!size) fail(size.error().message);
     auto mode = parseCullMode(o.mode);
     if (!mode) fail("--mode: " + mode.error().message);
+    if (o.flags.volume != "aabb" && *mode != CullMode::Full) fail("--volume: applies to --mode full only");
     auto made = makeScene(o.scene, o.sceneOptions);
     if (!made) fail(made.error().message);
     DemoScene& scene = **made;
@@ -136,10 +137,10 @@ void runRun(RunOptions o) {
         std::fprintf(stderr, "warning: %llu GL errors\n", static_cast<unsigned long long>(ctx.glErrorCount()));
     std::printf("stats: %s\n", o.stats.c_str());
     for (const std::string& p : written) std::printf("picture: %s\n", p.c_str());
-    std::printf("summary scene=%s mode=%s frames=%llu ms_per_frame=%.2f queries_per_frame=%.1f parts_per_frame=%.1f "
-                "triangles_per_frame=%.0f\n",
-                scene.name().c_str(), o.mode.c_str(), static_cast<unsigned long long>(frame), ms / n, queries / n,
-                parts / n, triangles / n);
+    std::printf("summary scene=%s mode=%s volume=%s frames=%llu ms_per_frame=%.2f queries_per_frame=%.1f "
+                "parts_per_frame=%.1f triangles_per_frame=%.0f\n",
+                scene.name().c_str(), o.mode.c_str(), o.flags.volume.c_str(), static_cast<unsigned long long>(frame),
+                ms / n, queries / n, parts / n, triangles / n);
 }
 
 }  // namespace

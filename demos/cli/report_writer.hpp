@@ -31,6 +31,11 @@ struct ModeSummary {
     std::uint64_t largestRegion = 0;          ///< largest wrong region of any frame, pixels
     std::uint64_t timeouts = 0;               ///< queries that never answered, summed
     double ratioVfc = 0, ratioOracle = 0;     ///< msMean / that mode's msMean (0 if absent)
+    // Query volumes (the k-DOP paper's Tables 2 and 5).
+    std::string volume;            ///< the mode's volume choice; empty if it does not query node volumes
+    double pctPartsCulled = 0;     ///< of the parts vfc draws, % not drawn (all frames together)
+    double queryTriangles = 0;     ///< per frame, of the query volumes drawn
+    LeafVolumeTotals leaves;       ///< world-space leaf volumes at the last frame (leaves == 0: n/a)
     bool pareto = false;  ///< on the speed-accuracy Pareto front (the oracle never is: it is not a real mode)
 };
 
@@ -51,6 +56,10 @@ struct PlotOutcome {
 /// Writes the plot data and gnuplot script into `dir` and runs gnuplot if it is on PATH.
 PlotOutcome writePlots(const BenchResult& result, const std::vector<ModeSummary>& summary,
                        const std::filesystem::path& dir);
+
+/// True when the report gets a query-volume table: some mode queries node volumes with a
+/// volume other than the default AABB (bench --volume/--volumes, or a MODE-VOLUME name).
+bool reportsVolumes(const BenchResult& result);
 
 /// DIR/report.md. `command` is the command line shown at the top; `plots` the PNGs to embed.
 Status writeReport(const BenchResult& result, const std::vector<ModeSummary>& summary, const std::string& command,

@@ -44,6 +44,13 @@ void addSchedulerOptions(CLI::App& cmd, SchedulerFlags& f) {
     cmd.add_flag("--no-tight", f.noTight, "full: query world AABBs instead of tightened object boxes");
     cmd.add_option("--max-in-flight", f.maxInFlight, "full: maximum queries in flight")->capture_default_str();
     cmd.add_option("--max-skip", f.maxSkip, "full: maximum frames a visible node skips its query")->capture_default_str();
+    cmd.add_option("--volume", f.volume, "full: query volume of object parts (auto picks per part)")
+        ->check(CLI::IsMember({"aabb", "obb", "kdop14", "kdop18", "kdop26", "auto"}))
+        ->capture_default_str();
+    cmd.add_option("--auto-saving", f.autoSaving,
+                   "full, --volume auto: a k-DOP replaces a part's box if it saves at least this fraction of surface area")
+        ->check(CLI::Range(0.0f, 1.0f))
+        ->capture_default_str();
     cmd.add_option("--pixel-threshold", f.pixelThreshold,
                    "cull nodes with at most this many visible samples (0 = conservative)")->capture_default_str();
     cmd.add_option("--front-percent", f.frontPercent,
@@ -61,6 +68,8 @@ SchedulerParams toParams(const SchedulerFlags& f, CullMode mode) {
     p.maxQueriesInFlight = f.maxInFlight;
     p.history.maxSkipFrames = f.maxSkip;
     p.frontPercent = f.frontPercent;
+    p.volume = parseVolumeChoice(f.volume).value();  // checked by the option's IsMember
+    p.autoVolumeSaving = f.autoSaving;
     return p;
 }
 

@@ -2,6 +2,8 @@
 // parameters and the scheduler's switches, registered on a CLI11 subcommand.
 #pragma once
 
+#include <string>
+
 #include <CLI/CLI.hpp>
 
 #include "dyncull/demos/demo_scene.hpp"
@@ -24,6 +26,8 @@ struct SchedulerFlags {
     std::uint32_t maxSkip = SchedulerParams{}.history.maxSkipFrames;
     std::uint32_t pixelThreshold = 0;
     float frontPercent = 0.0f;
+    std::string volume = "aabb";  ///< one of aabb, obb, kdop14, kdop18, kdop26, auto (checked by CLI11)
+    float autoSaving = SchedulerParams{}.autoVolumeSaving;
 };
 void addSchedulerOptions(CLI::App& cmd, SchedulerFlags& f);
 SchedulerParams toParams(const SchedulerFlags& f, CullMode mode);
