@@ -95,18 +95,7 @@ void registerBench(CLI::App& app) {
     cmd->add_option("--auto-saving", o->autoSaving,
                     "auto volume: a k-DOP replaces a node's box if it saves at least this fraction of surface area")
         ->capture_default_str();
-    cmd->add_option("--frames", o->measure.frames, "frames to measure")->capture_default_str();
-    cmd->add_option("--first", o->measure.firstFrame, "path frame of the first measured frame")->capture_default_str();
-    cmd->add_option("--stride", o->measure.stride,
-                    "measure every Nth frame of the path (the camera and objects move N times farther between "
-                    "measured frames, so visibility history has less coherence to use)")
-        ->check(CLI::Range(1, 1000))
-        ->capture_default_str();
-    cmd->add_option("--size", o->size, "framebuffer size WxH")->capture_default_str();
-    cmd->add_option("--out", o->measure.out, "output directory (default out/bench_<scene>)");
-    cmd->add_flag("--quiet", o->measure.quiet, "no progress lines");
-    addBunnyOptions(*cmd, o->measure.sceneOptions.bunny);
-    addGeneratedSceneOptions(*cmd, o->measure.sceneOptions);
+    addMeasureOptions(*cmd, o->measure, o->size, "out/bench_<scene>");
     cmd->callback([o] { runBench(*o); });
 }
 

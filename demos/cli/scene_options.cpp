@@ -15,6 +15,21 @@ void addBunnyOptions(CLI::App& cmd, BunnySwarmOptions& o) {
     cmd.add_option("--path-frames", o.frames, "bunnies: frames of one pass of the camera path")->capture_default_str();
 }
 
+void addMeasureOptions(CLI::App& cmd, MeasureOptions& o, std::string& size, const std::string& defaultOut) {
+    cmd.add_option("--frames", o.frames, "frames to measure")->capture_default_str();
+    cmd.add_option("--first", o.firstFrame, "path frame of the first measured frame")->capture_default_str();
+    cmd.add_option("--stride", o.stride,
+                   "measure every Nth frame of the path (the camera and objects move N times farther between "
+                   "measured frames, so visibility history has less coherence to use)")
+        ->check(CLI::Range(1, 1000))
+        ->capture_default_str();
+    cmd.add_option("--size", size, "framebuffer size WxH")->capture_default_str();
+    cmd.add_option("--out", o.out, "output directory (default " + defaultOut + ")");
+    cmd.add_flag("--quiet", o.quiet, "no progress lines");
+    addBunnyOptions(cmd, o.sceneOptions.bunny);
+    addGeneratedSceneOptions(cmd, o.sceneOptions);
+}
+
 void addGeneratedSceneOptions(CLI::App& cmd, SceneOptions& o) {
     cmd.add_option("--scene-dir", o.sceneDir, "powerplant: load every .ply/.obj under this directory instead of generating");
     cmd.add_option("--cache-dir", o.cache.dir, "powerplant/city: cache directory (default $DYNCULL_CACHE, else out/cache)");

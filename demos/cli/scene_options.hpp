@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "bench_runner.hpp"
 #include "dyncull/demos/demo_scene.hpp"
 #include "dyncull/scheduler/query_scheduler.hpp"
 
@@ -18,6 +19,10 @@ void addBunnyOptions(CLI::App& cmd, BunnySwarmOptions& o);
 /// --scene-dir --cache-dir --no-cache --plant-seed --plant-size --plant-detail --city-seed
 /// --city-blocks --threads, and --subdivide --max-tris --collapse for static scenes.
 void addGeneratedSceneOptions(CLI::App& cmd, SceneOptions& o);
+
+/// What bench and sweep share: --frames --first --stride --size (into `size`, parsed by
+/// the caller) --out (help names `defaultOut`) --quiet, and the scene options above.
+void addMeasureOptions(CLI::App& cmd, MeasureOptions& o, std::string& size, const std::string& defaultOut);
 
 /// Scheduler switches for `full` ablations and tuning.
 struct SchedulerFlags {
