@@ -126,6 +126,21 @@ std::vector<ModeSummary> summarise(const BenchResult& r) {
         if (queriesNodeVolumes(r.modes[m])) s.volume = toString(r.modes[m].scheduler.volume);
         if (m < r.leafTotals.size()) s.leaves = r.leafTotals[m];
     }
+    std::vector<double> ratios;
+    for (std::size_t m = 0; m < r.modes.size(); ++m) {
+        if (!queriesNodeVolumes(r.modes[m]) || r.frames.empty()) continue;
+        ratios.clear();
+        for (const auto& row : r.frames) {
+            double best = 0;
+            for (std::size_t k = 0; k < r.modes.size(); ++k)
+                if (queriesNodeVolumes(r.modes[k]) && (best == 0 || row[k].stats.frameMs < best)) best = row[k].stats.frameMs;
+            if (best > 0) ratios.push_back(row[m].stats.frameMs / best);
+        }
+        if (ratios.empty()) continue;
+        std::sort(ratios.begin(), ratios.end());
+        const std::size_t h = ratios.size() / 2;
+        out[m].pairedVsBest = ratios.size() % 2 ? ratios[h] : 0.5 * (ratios[h - 1] + ratios[h]);
+    }
     int oracle = -1;
     for (std::size_t i = 0; i < out.size(); ++i)
         if (out[i].oracle) oracle = static_cast<int>(i);
@@ -179,7 +194,7 @@ Status writeSummaryCsv(const std::vector<ModeSummary>& summary, const fs::path& 
          "triangles,queries,queries_occluded,skipped_history,skipped_occupancy,batches,pixels_wrong_pct_mean,"
          "pixels_wrong_pct_max,frames_wrong,false_negatives,false_negative_pixels,false_positives_per_frame,"
          "largest_wrong_region,timeouts,pareto,volume,pct_parts_culled,query_triangles,leaf_volume,"
-         "leaf_surface_area,leaf_triangles_mean,leaf_triangles_max\n";
+         "leaf_surface_area,leaf_triangles_mean,leaf_triangles_max,paired_vs_best\n";
     for (const ModeSummary& s : summary)
         f << s.name << ',' << s.frames << ',' << s.msMean << ',' << s.msMedian << ',' << s.msMin << ',' << s.msMax
           << ',' << s.traversalMs << ',' << s.queryMs << ',' << s.waitMs << ',' << s.drawMs << ',' << s.ratioVfc << ',' << s.ratioOracle
@@ -189,7 +204,7 @@ Status writeSummaryCsv(const std::vector<ModeSummary>& summary, const fs::path& 
           << ',' << s.largestRegion << ',' << s.timeouts << ',' << (s.pareto ? 1 : 0) << ',' << s.volume << ','
           << s.pctPartsCulled << ',' << s.queryTriangles << ',' << s.leaves.volume << ',' << s.leaves.surfaceArea << ','
           << (s.leaves.leaves ? static_cast<double>(s.leaves.triangles) / static_cast<double>(s.leaves.leaves) : 0.0)
-          << ',' << s.leaves.maxTriangles << '\n';
+          << ',' << s.leaves.maxTriangles << ',' << s.pairedVsBest << '\n';
     if (!f) return Error{path.string() + ": write failed"};
     return {};
 }
@@ -304,24 +319,26 @@ void writeVolumeTable(std::ofstream& f, const std::vector<ModeSummary>& summary)
       << "Per mode that queries node volumes (the k-DOP paper's Tables 2 and 5): time, culling, queries, and the "
          "world-space total volume and surface area of the query volumes of all object parts (local-BSP leaves) at "
          "the last frame.\n\n"
-      << "| mode | volume | ms/frame | vs best | parts culled (% of vfc's) | parts drawn | queries | occluded |"
+      << "| mode | volume | ms/frame | vs best | per-frame vs best | parts culled (% of vfc's) | parts drawn | queries | occluded |"
          " % occluded | triangles/query | leaf volume | leaf surface area | leaf triangles mean (max) |"
          " leaves aabb/obb/14/18/26 | false neg. (parts) |\n"
-      << "|---|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|---|--:|\n";
+      << "|---|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|---|--:|\n";
     for (const ModeSummary& s : summary) {
         if (s.volume.empty()) continue;
         const LeafVolumeTotals& l = s.leaves;
         std::string kinds;
         for (std::size_t k = 0; k < l.leavesByKind.size(); ++k) kinds += (k ? "/" : "") + std::to_string(l.leavesByKind[k]);
         f << "| " << s.name << " | " << s.volume << " | " << fmt(s.msMean, 2) << " | " << fmt(best > 0 ? s.msMean / best : 0, 3)
-          << " | " << fmt(s.pctPartsCulled, 1) << " | " << fmt(s.parts, 1) << " | " << fmt(s.queries, 1) << " | "
+          << " | " << fmt(s.pairedVsBest, 3) << " | " << fmt(s.pctPartsCulled, 1) << " | " << fmt(s.parts, 1) << " | " << fmt(s.queries, 1) << " | "
           << fmt(s.occluded, 1) << " | " << fmt(s.queries > 0 ? 100.0 * s.occluded / s.queries : 0.0, 1) << " | "
           << fmt(s.queries > 0 ? s.queryTriangles / s.queries : 0.0, 1) << " | " << sci(l.volume) << " | "
           << sci(l.surfaceArea) << " | "
           << fmt(l.leaves ? static_cast<double>(l.triangles) / static_cast<double>(l.leaves) : 0.0, 1) << " ("
           << l.maxTriangles << ") | " << kinds << " | " << s.falseNegatives << " |\n";
     }
-    f << "\n*vs best*: mean ms over the fastest volume mode's; *parts culled*: parts vfc drew that this mode did not, "
+    f << "\n*vs best*: mean ms over the fastest volume mode's; *per-frame vs best*: median over frames of the "
+         "frame's ms over the fastest volume mode's ms in the same frame (robust to load changes on a shared "
+         "machine); *parts culled*: parts vfc drew that this mode did not, "
          "over all frames; *triangles/query*: triangles of the query volumes per query issued (scene nodes and "
          "untightened objects are queried with 12-triangle world boxes); *leaves ...*: how many object parts got each "
          "kind (auto picks per part).\n";

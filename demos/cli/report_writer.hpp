@@ -35,6 +35,10 @@ struct ModeSummary {
     std::string volume;            ///< the mode's volume choice; empty if it does not query node volumes
     double pctPartsCulled = 0;     ///< of the parts vfc draws, % not drawn (all frames together)
     double queryTriangles = 0;     ///< per frame, of the query volumes drawn
+    /// Median over frames of this mode's ms over the fastest volume mode's ms in that same
+    /// frame (modes run interleaved, so the pairing cancels load drift on a shared machine);
+    /// 0 unless the mode queries node volumes.
+    double pairedVsBest = 0;
     LeafVolumeTotals leaves;       ///< world-space leaf volumes at the last frame (leaves == 0: n/a)
     bool pareto = false;  ///< on the speed-accuracy Pareto front (the oracle never is: it is not a real mode)
 };
