@@ -10,6 +10,7 @@
 #include <epoxy/gl.h>
 
 #include "dyncull/engine/gl_context.hpp"
+#include "sanitizer_driver_pin.hpp"
 
 namespace dyncull {
 
@@ -87,6 +88,7 @@ public:
         if (dpy == EGL_NO_DISPLAY) return failed("eglGetPlatformDisplay");
         EGLint major = 0, minor = 0;
         if (!eglInitialize(dpy, &major, &minor)) return failed("eglInitialize");
+        detail::pinLoadedGlDrivers();  // the driver is loaded now, even if context creation fails
         ++displayRefs()[dpy];
         display_ = dpy;  // from here the destructor releases it
         if (!eglBindAPI(EGL_OPENGL_API)) return failed("eglBindAPI(EGL_OPENGL_API)");

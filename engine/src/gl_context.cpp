@@ -5,6 +5,8 @@
 
 #include <epoxy/gl.h>
 
+#include "sanitizer_driver_pin.hpp"
+
 namespace dyncull {
 
 namespace {
@@ -34,6 +36,7 @@ void GlContext::initCommon(bool debug) {
         const GLubyte* s = glGetString(e);
         return s ? std::string(reinterpret_cast<const char*>(s)) : std::string();
     };
+    detail::pinLoadedGlDrivers();  // sanitizer builds only (no leak reports from an unloaded driver)
     renderer_ = str(GL_RENDERER);
     version_ = str(GL_VERSION);
     debug_ = false;
