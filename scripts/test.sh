@@ -3,8 +3,7 @@
 #   1. scripts/setup.sh: packages, bunny, the normal build in ./build;
 #   2. the whole default suite in ./build;
 #   3. an ASan + UBSan build in ./build-asan (DYNCULL_SANITIZE=ON, no benchmarks) and the
-#      default suite again under the sanitizers, leaks included (docs/RELIABILITY.md says
-#      which tests it leaves out and why).
+#      default suite again under the sanitizers, leaks included (docs/RELIABILITY.md).
 # Long tests (label `long`: soak, fuzzing) are not part of it: scripts/long_tests.sh.
 # DYNCULL_SKIP_SANITIZE=1 skips step 3 (e.g. for a quick local check).
 set -euo pipefail
@@ -20,11 +19,7 @@ fi
 echo "test: ASan + UBSan build in build-asan"
 cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDYNCULL_SANITIZE=ON -DDYNCULL_BUILD_BENCH=OFF >/dev/null
 cmake --build build-asan -j"$(nproc)"
-# Left out under the sanitizers: the conservative-culling flight (30 s there, and it
-# asserts no query hits the 250 ms wall-clock timeout, which a 3-5x slower sanitized
-# llvmpipe on a loaded machine does not guarantee); it runs in step 2.
-ASAN_EXCLUDE='^Conservative\.'
 ASAN_OPTIONS=detect_leaks=1:detect_stack_use_after_return=1:check_initialization_order=1:strict_init_order=1 \
 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-  ctest --test-dir build-asan --output-on-failure -j2 -E "$ASAN_EXCLUDE"
+  ctest --test-dir build-asan --output-on-failure -j2
 echo "test: all passed (default suite, and again under ASan + UBSan)"
