@@ -1,5 +1,6 @@
 // Scene cache: round trip, and every kind of damage (flipped byte, truncation, other
 // version, other parameters, garbage) detected with a reason and then rebuilt.
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 
@@ -171,6 +172,37 @@ TEST_F(SceneCache, LoadOrPrepareRebuildsDamagedCache) {
     cache.enabled = false;
     ASSERT_TRUE(loadOrPrepare(cache, "p.dcs", 12, 2, gen, nullptr));
     EXPECT_EQ(generated, 4);
+}
+
+TEST(SceneCacheFile, TinySceneRoundTripsAndSeedsTheFuzzer) {
+    // Two small models (a box and a box split by its local BSP) and three objects: the
+    // smallest cache that exercises every record. With $DYNCULL_FUZZ_SEEDS set
+    // (scripts/fuzz.sh) it is also the scene-cache fuzzer's seed.
+    GeneratedScene g;
+    g.meshes.resize(2);
+    procedural::MeshBuilder(g.meshes[0]).box(glm::vec3(-1.0f), glm::vec3(1.0f));
+    procedural::MeshBuilder two(g.meshes[1]);
+    two.box(glm::vec3(-1.0f), glm::vec3(0.0f));
+    two.box(glm::vec3(0.5f), glm::vec3(2.0f));
+    Transform t;
+    g.objects.push_back({0, t, true});
+    t.translation = {3.0f, 0.0f, 0.0f};
+    g.objects.push_back({1, t, false});
+    t.scale = glm::vec3(2.0f);
+    g.objects.push_back({1, t, true});
+    auto p = prepareScene(std::move(g), 1, nullptr);
+    ASSERT_TRUE(p) << p.error().message;
+    test::TempDir dir;
+    const auto file = dir.path() / "tiny.dcs";
+    ASSERT_TRUE(writeSceneCache(file, *p, 3).ok());
+    auto back = readSceneCache(file, 3);
+    ASSERT_TRUE(back) << back.error().message;
+    EXPECT_EQ(test::hashScene(*back), test::hashScene(*p));
+    if (const char* seeds = std::getenv("DYNCULL_FUZZ_SEEDS"); seeds && *seeds) {
+        const auto out = std::filesystem::path(seeds) / "dcs";
+        std::filesystem::create_directories(out);
+        std::filesystem::copy_file(file, out / "tiny.dcs", std::filesystem::copy_options::overwrite_existing);
+    }
 }
 
 TEST(SceneCacheFile, MissingFileIsAnError) {

@@ -1,7 +1,9 @@
 // Test helpers: a per-test temporary directory and small file writers.
 #pragma once
 
+#include <cctype>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -34,7 +36,24 @@ public:
     std::filesystem::path write(const std::string& name, const std::string& bytes) const {
         const auto p = file(name);
         std::ofstream(p, std::ios::binary) << bytes;
+        exportFuzzSeed(name, bytes);
         return p;
+    }
+
+    /// With $DYNCULL_FUZZ_SEEDS set (scripts/fuzz.sh), every file a test writes is also
+    /// copied to <seeds>/<extension>/<test>_<name>: the loader tests' good and broken
+    /// files are the fuzzers' seed corpora, so no binary seeds are committed.
+    static void exportFuzzSeed(const std::string& name, const std::string& bytes) {
+        const char* seeds = std::getenv("DYNCULL_FUZZ_SEEDS");
+        if (!seeds || !*seeds) return;
+        std::string ext = std::filesystem::path(name).extension().string();
+        for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+        if (ext.size() < 2) return;
+        const auto dir = std::filesystem::path(seeds) / ext.substr(1);
+        std::filesystem::create_directories(dir);
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        const std::string test = info ? std::string(info->test_suite_name()) + "." + info->name() : "test";
+        std::ofstream(dir / (test + "_" + name), std::ios::binary) << bytes;
     }
 
 private:
