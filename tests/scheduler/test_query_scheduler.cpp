@@ -4,10 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <functional>
 #include <map>
 #include <set>
+#include <thread>
 
 #include "dyncull/bsp/local_bsp.hpp"
 #include "dyncull/bsp/loose_bsp.hpp"
@@ -445,4 +447,123 @@ TEST(QueryVolume, NodeVolumesAreTransformedVertexByVertex) {
     const QueryVolume a = QueryVolume::fromNodeVolume(m, bsp.volumes, bsp.volumes.get(0, VolumeKind::Aabb));
     const QueryVolume b = QueryVolume::fromTransformedBox(m, bsp.nodes[0].box);
     for (int i = 0; i < 8; ++i) EXPECT_EQ(a.vertices[i], b.vertices[i]);
+}
+
+// ---- Faults: a backend that never answers (lost or hung GPU). The contract of
+// QueryBackend::wait is a bounded wait; the scheduler must then count the node visible
+// (never cull on a missing answer) and end the frame.
+
+namespace {
+
+// Never answers: poll is always NotReady; wait really waits `timeoutMs` of wall time (as
+// a GL backend polling a hung query would) and then gives up.
+struct HungBackend final : QueryBackend {
+    int issued = 0, released = 0, polls = 0, waits = 0;
+    std::vector<double> waitBounds;
+    void beginFrame(const Camera&, int, int) override {}
+    void beginBatch() override {}
+    QueryId issue(const QueryVolume&) override { return static_cast<QueryId>(issued++); }
+    void endBatch() override {}
+    QueryResult poll(QueryId) override {
+        ++polls;
+        return QueryResult::NotReady;
+    }
+    QueryResult wait(QueryId, double timeoutMs) override {
+        ++waits;
+        waitBounds.push_back(timeoutMs);
+        const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double, std::milli>(timeoutMs);
+        while (std::chrono::steady_clock::now() < until) std::this_thread::yield();
+        return QueryResult::NotReady;
+    }
+    void release(QueryId) override { ++released; }
+};
+
+}  // namespace
+
+TEST(QueryFaults, HungQueriesInTheWaitPathCountVisibleWithinTheBound) {
+    // Simple OC: every query goes through wait().
+    TestScene s(4, 3);
+    ScriptedBackend vfcBackend;
+    SchedulerParams vfc;
+    vfc.mode = CullMode::Vfc;
+    const auto reference = drawnWith(s, vfc, vfcBackend);
+    HungBackend b;
+    SchedulerParams p;
+    p.mode = CullMode::Simple;
+    p.queryTimeoutMs = 2.0;
+    QueryScheduler sched(p);
+    RecordingSink sink;
+    TwoLevelTree tree(s.bsp, s.objects);
+    const auto t0 = std::chrono::steady_clock::now();
+    const FrameStats st = sched.cullFrame(tree, frontCamera(), 640, 320, b, sink);
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    EXPECT_EQ(sink.drawn, reference);  // nothing culled on a missing answer
+    ASSERT_GT(b.issued, 0);
+    EXPECT_EQ(st.queriesTimedOut, static_cast<std::uint32_t>(b.issued));
+    EXPECT_EQ(b.waits, b.issued);
+    for (double bound : b.waitBounds) EXPECT_EQ(bound, 2.0);
+    EXPECT_EQ(b.released, b.issued);
+    // Each wait is bounded: the frame costs about issued x 2 ms, not forever (generous
+    // slack for a loaded machine).
+    EXPECT_LT(ms, b.issued * 2.0 + 2000.0);
+}
+
+TEST(QueryFaults, HungQueriesInTheNonBlockingPathCountVisibleWithinTheBound) {
+    // Full mode polls first and only waits when nothing else is left; with a small
+    // in-flight limit it must go through both paths many times.
+    TestScene s(5, 4);
+    ScriptedBackend vfcBackend;
+    SchedulerParams vfc;
+    vfc.mode = CullMode::Vfc;
+    const auto reference = drawnWith(s, vfc, vfcBackend);
+    HungBackend b;
+    SchedulerParams p;
+    p.mode = CullMode::Full;
+    p.useOccupancyAccept = false;  // force queries
+    p.useHistory = false;
+    p.maxQueriesInFlight = 3;
+    p.queryTimeoutMs = 1.0;
+    QueryScheduler sched(p);
+    RecordingSink sink;
+    TwoLevelTree tree(s.bsp, s.objects);
+    for (int frame = 0; frame < 3; ++frame) {
+        sink.drawn.clear();
+        const int issuedBefore = b.issued;
+        const FrameStats st = sched.cullFrame(tree, frontCamera(), 640, 320, b, sink);
+        EXPECT_EQ(sink.drawn, reference) << "frame " << frame;
+        EXPECT_GT(st.queriesIssued, 0u);
+        EXPECT_EQ(st.queriesTimedOut, st.queriesIssued);
+        EXPECT_EQ(b.issued - issuedBefore, static_cast<int>(st.queriesIssued));
+    }
+    EXPECT_GT(b.polls, b.waits);  // the non-blocking path was taken before every wait
+    EXPECT_EQ(b.waits, b.issued);  // and each query was waited for exactly once, bounded
+    EXPECT_EQ(b.released, b.issued);
+}
+
+TEST(QueryFaults, HungQueriesWithLastFrameResultsNeverCullAndNeverPileUp) {
+    // The approximate one-frame-latency setting never waits: unanswered queries stay
+    // in flight, the node stays visible, and no second query is stacked on it.
+    TestScene s(4, 3);
+    ScriptedBackend vfcBackend;
+    SchedulerParams vfc;
+    vfc.mode = CullMode::Vfc;
+    const auto reference = drawnWith(s, vfc, vfcBackend);
+    HungBackend b;
+    SchedulerParams p;
+    p.useOccupancyAccept = false;
+    p.useHistory = false;
+    p.useLastFrameResults = true;
+    QueryScheduler sched(p);
+    RecordingSink sink;
+    TwoLevelTree tree(s.bsp, s.objects);
+    int issuedAfterFirst = 0;
+    for (int frame = 0; frame < 20; ++frame) {
+        sink.drawn.clear();
+        sched.cullFrame(tree, frontCamera(), 640, 320, b, sink);
+        EXPECT_EQ(sink.drawn, reference) << "frame " << frame;
+        if (frame == 0) issuedAfterFirst = b.issued;
+    }
+    EXPECT_GT(issuedAfterFirst, 0);
+    EXPECT_EQ(b.issued, issuedAfterFirst);  // bounded: one query per node at most
+    EXPECT_EQ(b.waits, 0);
 }
