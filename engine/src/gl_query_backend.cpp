@@ -4,7 +4,10 @@
 // and colour writes off).
 #include "dyncull/engine/gl_query_backend.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cassert>
+#include <cmath>
 #include <chrono>
 #include <cstdint>
 #include <cstring>
@@ -76,7 +79,9 @@ GlQueryBackend::~GlQueryBackend() {
 }
 
 void GlQueryBackend::beginFrame(const Camera& camera, int, int) {
-    viewProj_ = camera.viewProjection();
+    // Camera-relative like the renderer: volumes are uploaded relative to the eye.
+    viewProj_ = camera.viewProjectionRelative();
+    eye_ = glm::dvec3(camera.position);
     // Orphan last frame's volumes so writing this frame's never waits on the rasteriser.
     glNamedBufferData(vbo_, vboCapacity_ * sizeof(glm::vec3), nullptr, GL_STREAM_DRAW);
     vboUsed_ = 0;
@@ -123,7 +128,29 @@ QueryId GlQueryBackend::issue(const QueryVolume& volume) {
         glNamedBufferData(meshIbo_, iboCapacity_, nullptr, GL_STREAM_DRAW);
         iboUsed_ = 0;
     }
-    glNamedBufferSubData(vbo_, vboUsed_ * sizeof(glm::vec3), nv * sizeof(glm::vec3), volume.vertices.data());
+    // Vertices relative to the eye, each pushed away from the volume's centre by the float
+    // rounding its world coordinates may carry (2^-22 of the largest magnitude, i.e. 2 ulp):
+    // a volume 1e7 units from the origin is never smaller than the geometry it bounds, so
+    // the query stays conservative. On an axis where rounding collapsed a box flat (sign
+    // 0), the corner's index bit says which side it belongs to.
+    std::array<glm::vec3, QueryVolume::kMaxVertices> rel;
+    glm::dvec3 centre(0.0);
+    double magnitude = 0.0;
+    for (std::uint32_t i = 0; i < nv; ++i) {
+        const glm::dvec3 v(volume.vertices[i]);
+        centre += v / double(nv);
+        magnitude = std::max({magnitude, std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+    }
+    const double slack = magnitude * 0x1p-22;
+    for (std::uint32_t i = 0; i < nv; ++i) {
+        const glm::dvec3 v(volume.vertices[i]);
+        glm::dvec3 out = glm::sign(v - centre);
+        if (volume.isBox())
+            for (int a = 0; a < 3; ++a)
+                if (out[a] == 0.0) out[a] = (i >> a) & 1u ? 1.0 : -1.0;
+        rel[i] = glm::vec3(v + out * slack - eye_);
+    }
+    glNamedBufferSubData(vbo_, vboUsed_ * sizeof(glm::vec3), nv * sizeof(glm::vec3), rel.data());
     if (!volume.isBox()) glNamedBufferSubData(meshIbo_, iboUsed_, ni, volume.indices.data());
     if (boundMesh_ != !volume.isBox()) {
         boundMesh_ = !volume.isBox();

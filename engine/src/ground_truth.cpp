@@ -112,8 +112,9 @@ VisibleSet GroundTruth::compute(const SceneObjects& objects, const Camera& camer
         glNamedFramebufferTexture(fbo_, GL_DEPTH_ATTACHMENT, depth_, 0);
     }
 
-    const glm::mat4 viewProj = camera.viewProjection();
-    candidates_ = frustumLeavesBruteForce(objects, Frustum::fromMatrix(viewProj));
+    // Camera-relative, exactly as the renderer: same matrices, so bit-identical depths.
+    const glm::mat4 viewProj = camera.viewProjectionRelative();
+    candidates_ = frustumLeavesBruteForce(objects, Frustum::fromCamera(camera));
 
     glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
     glViewport(0, 0, width_, height_);
@@ -135,7 +136,7 @@ VisibleSet GroundTruth::compute(const SceneObjects& objects, const Camera& camer
         const LocalBspNode& n = objects.model(model).nodes[ref.node];
         if (n.indexCount == 0) continue;
         glUniform1ui(locId_, static_cast<GLuint>(i + 1));
-        glUniformMatrix4fv(locModel_, 1, GL_FALSE, glm::value_ptr(objects.matrix(ref.object)));
+        glUniformMatrix4fv(locModel_, 1, GL_FALSE, glm::value_ptr(camera.relativeModel(objects.matrix(ref.object))));
         glBindVertexArray(models_[model].vao);
         glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(n.indexCount), GL_UNSIGNED_INT,
                        reinterpret_cast<const void*>(static_cast<std::uintptr_t>(n.firstIndex) * sizeof(std::uint32_t)));

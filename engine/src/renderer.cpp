@@ -91,6 +91,12 @@ void Renderer::beginFrame(const Camera& camera) {
     glDisable(GL_CULL_FACE);  // loaded meshes have unreliable winding; the shader lights both sides
 
     viewProj_ = camera.viewProjection();
+    // Camera-relative transforms: uViewProj has no translation and uModel carries the
+    // object's offset from the eye (computed in double), so the shader's "world" position
+    // is relative to the eye and stays precise far from the world origin; the eye is then
+    // at the origin for lighting.
+    camera_ = camera;
+    const glm::mat4 viewProjRel = camera.viewProjectionRelative();
     // Key light over the viewer's left shoulder, so silhouettes and creases get shading.
     const glm::vec3 f = camera.forward();
     glm::vec3 right = glm::cross(f, camera.up);
@@ -99,8 +105,9 @@ void Renderer::beginFrame(const Camera& camera) {
     const glm::vec3 light = glm::normalize(-f + 0.9f * up - 0.6f * right);
 
     glUseProgram(program_);
-    glUniformMatrix4fv(locViewProj_, 1, GL_FALSE, glm::value_ptr(viewProj_));
-    glUniform3fv(locEye_, 1, glm::value_ptr(camera.position));
+    glUniformMatrix4fv(locViewProj_, 1, GL_FALSE, glm::value_ptr(viewProjRel));
+    const glm::vec3 eyeRelative(0.0f);
+    glUniform3fv(locEye_, 1, glm::value_ptr(eyeRelative));
     glUniform3fv(locLight_, 1, glm::value_ptr(light));
 }
 
@@ -114,7 +121,8 @@ void Renderer::drawRange(MeshId id, std::uint32_t firstIndex, std::uint32_t coun
     // draw on the CPU instead of per vertex.
     const glm::mat3 normalMat = glm::inverseTranspose(glm::mat3(model));
     glUseProgram(program_);
-    glUniformMatrix4fv(locModel_, 1, GL_FALSE, glm::value_ptr(model));
+    const glm::mat4 relative = camera_.relativeModel(model);
+    glUniformMatrix4fv(locModel_, 1, GL_FALSE, glm::value_ptr(relative));
     glUniformMatrix3fv(locNormalMat_, 1, GL_FALSE, glm::value_ptr(normalMat));
     glUniform3fv(locColour_, 1, glm::value_ptr(colour));
     glBindVertexArray(g.vao);

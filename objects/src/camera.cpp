@@ -11,6 +11,21 @@ glm::mat4 Camera::view() const { return glm::lookAt(position, target, up); }
 
 glm::mat4 Camera::projection() const { return glm::perspective(fovYRadians, aspect, nearPlane, farPlane); }
 
+glm::mat4 Camera::viewProjectionRelative() const {
+    const glm::dvec3 eye(position);
+    const glm::dmat4 rot = glm::lookAt(glm::dvec3(0.0), glm::dvec3(target) - eye, glm::dvec3(up));
+    const glm::dmat4 proj = glm::perspective(double(fovYRadians), double(aspect), double(nearPlane), double(farPlane));
+    return glm::mat4(proj * rot);
+}
+
+glm::mat4 Camera::relativeModel(const glm::mat4& objectToWorld) const {
+    glm::mat4 m = objectToWorld;
+    // Float minus float in double is exact; the rounding back to float then loses only
+    // what the camera-relative position itself cannot hold.
+    m[3] = glm::vec4(glm::vec3(glm::dvec3(objectToWorld[3]) - glm::dvec3(position)), objectToWorld[3][3]);
+    return m;
+}
+
 glm::vec3 Camera::forward() const { return glm::normalize(target - position); }
 
 Camera Camera::framing(const Aabb& box, float aspectRatio, const glm::vec3& dir) {
@@ -59,17 +74,24 @@ Frustum Frustum::fromMatrix(const glm::mat4& m) {
     return f;
 }
 
+Frustum Frustum::fromCamera(const Camera& camera) {
+    Frustum f = fromMatrix(camera.viewProjectionRelative());
+    f.origin = glm::dvec3(camera.position);
+    return f;
+}
+
 Frustum::Side Frustum::classify(const Aabb& box) const {
+    // Double: box corners minus the origin are exact, so a world box 1e7 units from the
+    // origin is tested as precisely as one next to it.
+    const glm::dvec3 lo = glm::dvec3(box.min) - origin, hi = glm::dvec3(box.max) - origin;
     bool inside = true;
     for (const glm::vec4& p : planes) {
-        const glm::vec3 n(p);
+        const glm::dvec3 n(p);
         // Positive vertex (furthest along n) and negative vertex.
-        const glm::vec3 pv(n.x >= 0 ? box.max.x : box.min.x, n.y >= 0 ? box.max.y : box.min.y,
-                           n.z >= 0 ? box.max.z : box.min.z);
-        const glm::vec3 nv(n.x >= 0 ? box.min.x : box.max.x, n.y >= 0 ? box.min.y : box.max.y,
-                           n.z >= 0 ? box.min.z : box.max.z);
-        if (glm::dot(n, pv) + p.w < 0.0f) return Side::Outside;
-        if (glm::dot(n, nv) + p.w < 0.0f) inside = false;
+        const glm::dvec3 pv(n.x >= 0 ? hi.x : lo.x, n.y >= 0 ? hi.y : lo.y, n.z >= 0 ? hi.z : lo.z);
+        const glm::dvec3 nv(n.x >= 0 ? lo.x : hi.x, n.y >= 0 ? lo.y : hi.y, n.z >= 0 ? lo.z : hi.z);
+        if (glm::dot(n, pv) + double(p.w) < 0.0) return Side::Outside;
+        if (glm::dot(n, nv) + double(p.w) < 0.0) inside = false;
     }
     return inside ? Side::Inside : Side::Intersecting;
 }

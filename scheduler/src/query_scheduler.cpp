@@ -71,8 +71,10 @@ FrameStats QueryScheduler::cullFrame(const TwoLevelTree& tree, const Camera& cam
     backend_ = &backend;
     sink_ = &sink;
     camera_ = camera;
-    viewProj_ = camera.viewProjection();
-    frustum_ = Frustum::fromMatrix(viewProj_);
+    // Camera-relative (eye at the origin, set up in double): precise at any distance from
+    // the world origin, like the renderer's and the query backend's transforms.
+    viewProj_ = camera.viewProjectionRelative();
+    frustum_ = Frustum::fromCamera(camera);
     width_ = width;
     height_ = height;
     stats_ = &st;
@@ -145,9 +147,9 @@ bool QueryScheduler::projectRect(const Aabb& box, ScreenRect& out) const {
     bool front[8];
     bool crosses = false;
     for (int i = 0; i < 8; ++i) {
-        const glm::vec3 c((i & 1) ? box.max.x : box.min.x, (i & 2) ? box.max.y : box.min.y,
-                          (i & 4) ? box.max.z : box.min.z);
-        clip[i] = viewProj_ * glm::vec4(c, 1.0f);
+        const glm::dvec3 c((i & 1) ? box.max.x : box.min.x, (i & 2) ? box.max.y : box.min.y,
+                           (i & 4) ? box.max.z : box.min.z);
+        clip[i] = viewProj_ * glm::vec4(glm::vec3(c - glm::dvec3(camera_.position)), 1.0f);
         front[i] = clip[i].z >= -clip[i].w;  // in front of the near plane (GL clip space)
         crosses |= !front[i];
     }

@@ -69,7 +69,8 @@ private:
     std::uint32_t iboCapacity_ = 0;  // mesh indices (bytes)
     std::uint32_t iboUsed_ = 0;      // mesh indices written this frame
     bool boundMesh_ = false;         // meshVao_ (not boxVao_) bound in this batch
-    glm::mat4 viewProj_{1.0f};
+    glm::mat4 viewProj_{1.0f};       // camera-relative (Camera::viewProjectionRelative)
+    glm::dvec3 eye_{0.0};            // world-space eye; volumes are uploaded relative to it
     // State saved by beginBatch, restored by endBatch.
     int savedDepthFunc_ = 0;
     bool savedCull_ = false, savedDepthTest_ = false;

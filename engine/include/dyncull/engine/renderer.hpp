@@ -89,7 +89,8 @@ private:
     std::size_t uploadedBytes_ = 0;
     std::uint32_t program_ = 0;
     int locViewProj_ = -1, locModel_ = -1, locNormalMat_ = -1, locColour_ = -1, locEye_ = -1, locLight_ = -1;
-    glm::mat4 viewProj_{1.0f};
+    glm::mat4 viewProj_{1.0f};  // world space (box overlays); parts are drawn camera-relative
+    Camera camera_;             // of the current frame, for camera-relative model matrices
     RenderStats stats_;
     std::unique_ptr<BoxDrawer> boxes_;
 };

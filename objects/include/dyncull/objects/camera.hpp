@@ -23,6 +23,15 @@ struct Camera {
     glm::mat4 view() const;
     glm::mat4 projection() const;
     glm::mat4 viewProjection() const { return projection() * view(); }
+    /// Camera-relative view-projection: projection times the rotation-only view, computed
+    /// in double, for positions given relative to the eye (world minus `position`).
+    /// Renderers use it with camera-relative model matrices (relativeModel) so precision
+    /// does not depend on the distance from the world origin (world-space float matrices
+    /// lose whole pixels beyond ~1e5 units).
+    glm::mat4 viewProjectionRelative() const;
+    /// `objectToWorld` with the eye subtracted from its translation, in double: the
+    /// object-to-camera-relative matrix to pair with viewProjectionRelative().
+    glm::mat4 relativeModel(const glm::mat4& objectToWorld) const;
     glm::vec3 forward() const;
 
     /// Camera placed to see all of `box` from direction `dir`, near/far fitted to it.
@@ -35,9 +44,16 @@ Status validateCamera(const Camera& camera);
 /// Six planes (left, right, bottom, top, near, far) with inward normals: a point p is
 /// inside when dot(n, p) + d >= 0 for all planes. Extracted from a view-projection matrix.
 struct Frustum {
-    std::array<glm::vec4, 6> planes;  ///< xyz = normal (normalised), w = d
+    std::array<glm::vec4, 6> planes;  ///< xyz = normal (normalised), w = d; relative to `origin`
+    /// Planes are given for points relative to this world point (0 for a world-space
+    /// matrix, the eye for fromCamera); classify subtracts it in double.
+    glm::dvec3 origin{0.0};
 
     static Frustum fromMatrix(const glm::mat4& viewProjection);
+    /// The camera's frustum built camera-relative (viewProjectionRelative, origin = eye):
+    /// exact to float precision of the planes near the eye at any distance from the world
+    /// origin, where planes of a world-space float matrix are off by whole units at 1e7.
+    static Frustum fromCamera(const Camera& camera);
 
     enum class Side { Outside, Intersecting, Inside };
     /// Conservative: Outside only if the box is fully behind one plane.
