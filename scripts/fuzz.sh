@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Fuzzes every file format dyncull reads or writes with libFuzzer (ASan + UBSan):
 #   scripts/fuzz.sh [seconds per target, default 600] [targets..., default all]
-# targets: fuzz_ply fuzz_obj fuzz_gltf fuzz_scene_cache. Two run at a time (2 cores).
+# targets: fuzz_ply fuzz_obj fuzz_gltf fuzz_scene_cache fuzz_subdivision_file. Two run at
+# a time (2 cores).
 # Seeds are the files the unit tests write (DYNCULL_FUZZ_SEEDS), taken from ./build, so run
 # scripts/setup.sh first. Corpora grow in out/fuzz/<target>/corpus across runs; a crash,
 # hang (>10 s per input) or out-of-memory (>2 GiB) leaves its input in out/fuzz/<target>/
@@ -12,10 +13,10 @@ cd "$(dirname "$0")/.."
 SECONDS_PER_TARGET=${1:-600}
 shift || true
 TARGETS=("$@")
-((${#TARGETS[@]})) || TARGETS=(fuzz_ply fuzz_obj fuzz_gltf fuzz_scene_cache)
+((${#TARGETS[@]})) || TARGETS=(fuzz_ply fuzz_obj fuzz_gltf fuzz_scene_cache fuzz_subdivision_file)
 
 command -v clang++ >/dev/null || { echo "fuzz: needs clang (apt-get install clang)" >&2; exit 2; }
-[[ -x build/bin/objects_tests && -x build/bin/demos_tests ]] || { echo "fuzz: run scripts/setup.sh first (seeds come from ./build's tests)" >&2; exit 2; }
+[[ -x build/bin/objects_tests && -x build/bin/demos_tests && -x build/bin/test_subdivision ]] || { echo "fuzz: run scripts/setup.sh first (seeds come from ./build's tests)" >&2; exit 2; }
 
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDYNCULL_FUZZ=ON \
   -DDYNCULL_BUILD_TESTS=OFF -DDYNCULL_BUILD_BENCH=OFF >/dev/null
@@ -27,6 +28,7 @@ rm -rf "$SEEDS"
 mkdir -p "$SEEDS"
 DYNCULL_FUZZ_SEEDS=$PWD/$SEEDS build/bin/objects_tests --gtest_filter='Ply*:Obj*:Gltf*:SceneLoader*' >/dev/null
 DYNCULL_FUZZ_SEEDS=$PWD/$SEEDS build/bin/demos_tests --gtest_filter='SceneCacheFile.TinySceneRoundTripsAndSeedsTheFuzzer' >/dev/null
+DYNCULL_FUZZ_SEEDS=$PWD/$SEEDS build/bin/test_subdivision --gtest_filter='SubdivisionFileTest.RoundTrip' >/dev/null
 
 seed_dirs() {
   case $1 in
@@ -34,6 +36,7 @@ seed_dirs() {
     fuzz_obj) echo "$SEEDS/obj" ;;
     fuzz_gltf) echo "$SEEDS/gltf $SEEDS/glb" ;;
     fuzz_scene_cache) echo "$SEEDS/dcs" ;;
+    fuzz_subdivision_file) echo "$SEEDS/dsub" ;;
   esac
 }
 

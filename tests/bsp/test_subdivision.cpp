@@ -4,6 +4,7 @@
 // degenerate inputs, the 4-ary collapse, leaf models and the subdivision file.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -334,6 +335,12 @@ protected:
         model_.sourceHash = 1234;
         path_ = dir_ / "m.dsub";
         ASSERT_TRUE(writeSubdivisionFile(path_, model_));
+        // scripts/fuzz.sh: this small file is the subdivision-file fuzzer's seed.
+        if (const char* seeds = std::getenv("DYNCULL_FUZZ_SEEDS"); seeds && *seeds) {
+            const auto out = std::filesystem::path(seeds) / "dsub";
+            std::filesystem::create_directories(out);
+            std::filesystem::copy_file(path_, out / "m.dsub", std::filesystem::copy_options::overwrite_existing);
+        }
     }
     void TearDown() override { std::filesystem::remove_all(dir_); }
 
