@@ -63,7 +63,9 @@ void writeBlobPly(const fs::path& path, int rings, int segments) {
 TEST(Soak, TenThousandFramesOfAMovingSwarm) {
     std::uint64_t frames = 10000;
     if (const char* e = std::getenv("DYNCULL_SOAK_FRAMES")) frames = std::max<std::uint64_t>(300, std::strtoull(e, nullptr, 10));
-    const std::uint64_t warmup = frames / 10;  // caches, pools and the tree reach steady state
+    // Caches, pools, the tree and llvmpipe's per-thread allocations reach steady state: a
+    // first run's RSS stepped up by ~18 MB between frames 1,000 and 2,000, then stayed flat.
+    const std::uint64_t warmup = frames * 3 / 10 / 100 * 100;
 
     const fs::path dir = fs::temp_directory_path() / ("dyncull_soak_" + std::to_string(::getpid()));
     fs::create_directories(dir);
@@ -116,8 +118,13 @@ TEST(Soak, TenThousandFramesOfAMovingSwarm) {
             EXPECT_EQ(e.falseNegatives, 0u) << "frame " << f;
             ++checked;
         }
+        if (f % 1000 == 0)
+            std::printf("soak: frame %llu RSS %ld KiB, query pool %zu, tree nodes %u\n", static_cast<unsigned long long>(f),
+                        residentKiB(), engine.queryBackend().poolSize(), engine.sceneTree().nodeCount());
+        // Sampled at the same point of every 100th frame (after the ground-truth pass), so
+        // transient allocations inside a frame do not count as growth.
         if (f == warmup) rssAfterWarmup = residentKiB();
-        if (f > warmup) rssMax = std::max(rssMax, residentKiB());
+        if (f > warmup && f % 100 == 0) rssMax = std::max(rssMax, residentKiB());
         ASSERT_EQ(ctx->checkErrors(), 0u) << "GL error by frame " << f;
     }
     const double growth = 100.0 * static_cast<double>(rssMax - rssAfterWarmup) / static_cast<double>(rssAfterWarmup);
