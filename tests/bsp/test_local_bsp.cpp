@@ -11,6 +11,7 @@
 
 #include "dyncull/bsp/local_bsp.hpp"
 #include "dyncull/objects/loaders.hpp"
+#include "objects/sphere_grid.hpp"
 
 namespace dyncull {
 namespace {
@@ -26,14 +27,7 @@ Mesh sphereMesh(int slices, int stacks, float radius = 1.0f, glm::vec3 centre = 
                                                               std::sin(phi) * std::sin(theta)));
         }
     }
-    for (int j = 0; j < stacks; ++j) {
-        for (int i = 0; i < slices; ++i) {
-            const auto a = std::uint32_t(j * slices + i), b = std::uint32_t(j * slices + (i + 1) % slices);
-            const auto c = a + std::uint32_t(slices), d = b + std::uint32_t(slices);
-            if (j > 0) m.indices.insert(m.indices.end(), {a, b, c});
-            if (j + 1 < stacks) m.indices.insert(m.indices.end(), {b, d, c});
-        }
-    }
+    test::appendSphereGridTriangles(m, slices, stacks);
     return m;
 }
 

@@ -15,6 +15,7 @@
 #include "dyncull/objects/convex_mesh.hpp"
 #include "objects/convex_checks.hpp"
 #include "objects/volume_test_points.hpp"
+#include "objects/sphere_grid.hpp"
 
 namespace dyncull {
 namespace {
@@ -33,13 +34,7 @@ Mesh lumpyMesh(int slices, int stacks, const glm::mat3& rot, glm::vec3 offset) {
                                                                 0.5f * std::sin(phi) * std::sin(theta))));
         }
     }
-    for (int j = 0; j < stacks; ++j)
-        for (int i = 0; i < slices; ++i) {
-            const auto a = std::uint32_t(j * slices + i), b = std::uint32_t(j * slices + (i + 1) % slices);
-            const auto c = a + std::uint32_t(slices), d = b + std::uint32_t(slices);
-            if (j > 0) m.indices.insert(m.indices.end(), {a, b, c});
-            if (j + 1 < stacks) m.indices.insert(m.indices.end(), {b, d, c});
-        }
+    test::appendSphereGridTriangles(m, slices, stacks);
     return m;
 }
 

@@ -16,6 +16,7 @@
 #include "dyncull/bsp/scene_objects.hpp"
 #include "dyncull/bsp/traversal.hpp"
 #include "dyncull/scheduler/query_scheduler.hpp"
+#include "objects/sphere_grid.hpp"
 
 using namespace dyncull;
 
@@ -354,13 +355,7 @@ Mesh lumpySphere() {
             m.positions.push_back(r * glm::vec3(std::sin(phi) * std::cos(th), 0.7f * std::cos(phi), std::sin(phi) * std::sin(th)));
         }
     }
-    for (int j = 0; j < stacks; ++j)
-        for (int i = 0; i < slices; ++i) {
-            const auto a = std::uint32_t(j * slices + i), b = std::uint32_t(j * slices + (i + 1) % slices);
-            const auto c = a + std::uint32_t(slices), d = b + std::uint32_t(slices);
-            if (j > 0) m.indices.insert(m.indices.end(), {a, b, c});
-            if (j + 1 < stacks) m.indices.insert(m.indices.end(), {b, d, c});
-        }
+    test::appendSphereGridTriangles(m, slices, stacks);
     return m;
 }
 
