@@ -279,6 +279,7 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
     ft.visibleParts = static_cast<std::uint32_t>(truth_.parts.size());
     ft.frustumParts = truth_.candidates;
     ft.coveredPixels = truth_.coveredPixels;
+    ft.artefactPixels = truth_.artefactPixels;
 
     // The oracle draws the visible parts front-to-back like the other modes, so it gets
     // the same early-depth rejection and is a fair lower bound.

@@ -76,6 +76,7 @@ struct FrameTruth {
     std::uint64_t coveredPixels = 0;  ///< pixels showing any part
     double groundTruthMs = 0.0;       ///< ID pass (not counted in any mode's time)
     double updateMs = 0.0;            ///< loose-BSP relink, once per frame for all modes
+    std::uint32_t artefactPixels = 0; ///< ID-pass pixels dropped as depth artefacts (VisibleSet::artefactPixels)
 };
 
 struct BenchResult {

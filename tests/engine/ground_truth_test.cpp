@@ -62,6 +62,7 @@ struct QuadAndCube : ::testing::Test {
             }
         EXPECT_EQ(mismatched, 0u);
         EXPECT_EQ(nonClear, vs.coveredPixels);
+        EXPECT_EQ(vs.artefactPixels, 0u);  // every fragment lies within its box's depth range
     }
 };
 
@@ -111,6 +112,44 @@ TEST_F(QuadAndCube, DrawnPartsAreComparedWithTheTruth) {
     EXPECT_EQ(st.partsDrawn, 1u);
     EXPECT_EQ(engine->renderer().readPixels().rgba, vfcImage.rgba);
     EXPECT_EQ(ctx->checkErrors(), 0u);
+}
+
+TEST(GroundTruthArtefacts, FragmentsOutsideTheirBoxDepthRangeAreNotCounted) {
+    // A rasteriser that writes a fragment nearer or farther than anything its part's box
+    // can hold (llvmpipe does, rarely, for tiny edge-on triangles) is imitated by a model
+    // whose stored box was moved behind its geometry: every pixel is then an artefact.
+    std::unique_ptr<GlContext> ctx = headless();
+    ASSERT_TRUE(ctx);
+    auto e = Engine::create(*ctx);
+    ASSERT_TRUE(e.ok());
+    std::unique_ptr<Engine> engine = e.take();
+    auto g = GroundTruth::create(*ctx);
+    ASSERT_TRUE(g.ok());
+    std::unique_ptr<GroundTruth> truth = g.take();
+    auto honest = buildLocalBsp(test::quadMesh(1.0f));
+    ASSERT_TRUE(honest.ok());
+    LocalBsp shifted = *honest;
+    ASSERT_EQ(shifted.nodes.size(), 1u);
+    shifted.nodes[0].box.min.z -= 2.0f;  // the quad (z = 0) lies in front of [-2, -2 + thickness]
+    shifted.nodes[0].box.max.z -= 2.0f;
+    const ModelId good = engine->addModel(honest.take());
+    const ModelId bad = engine->addModel(std::move(shifted));
+    const ObjectHandle a = *engine->addObject(good, at({-1.2f, 0, 0}));
+    const ObjectHandle b = *engine->addObject(bad, at({1.2f, 0, 0}));
+    ASSERT_TRUE(engine->setCamera(cameraOnZ(4.0f)).ok());
+    const VisibleSet vs = truth->compute(*engine, engine->camera());
+    ASSERT_EQ(vs.parts.size(), 1u);
+    EXPECT_EQ(vs.parts[0], (PartKey{a.index, 0}));
+    EXPECT_FALSE(vs.contains({b.index, 0}));
+    // The two quads are mirror images on screen, so the artefacts are about as many
+    // pixels as the honest quad owns.
+    EXPECT_GT(vs.artefactPixels, vs.coveredPixels * 9 / 10);
+    EXPECT_LT(vs.artefactPixels, vs.coveredPixels * 11 / 10);
+    for (std::uint32_t id : truth->idImage()) {
+        if (id != 0) {
+            EXPECT_EQ(truth->lastParts()[id - 1], (NodeRef{a.index, 0}));
+        }
+    }
 }
 
 TEST(DrawnPartRecorder, RangesMapToTheLeavesTheyCover) {

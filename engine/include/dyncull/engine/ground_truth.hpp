@@ -35,6 +35,10 @@ struct VisibleSet {
     std::vector<std::uint32_t> pixels;   ///< pixels[i]: pixels part i owns (> 0)
     std::uint64_t coveredPixels = 0;     ///< sum of pixels (pixels showing any part)
     std::uint32_t candidates = 0;        ///< parts drawn by the ID pass (not outside the frustum)
+    /// ID-pass pixels dropped as rasteriser depth artefacts: the fragment's depth lies
+    /// outside the window-depth range of its own part's box, so it is no surface point
+    /// (see GroundTruth::compute). Not in `pixels` nor `coveredPixels`.
+    std::uint32_t artefactPixels = 0;
 
     /// Pixels of `key`, 0 if not visible. O(log n).
     std::uint32_t pixelsOf(PartKey key) const;
@@ -68,6 +72,10 @@ public:
 private:
     explicit GroundTruth(GlContext& context) : context_(context) {}
     void uploadModels(const SceneObjects& objects);
+    /// Window-depth interval (with rounding slack) that every correct fragment of leaf
+    /// `ref` lies in; [-1, 2] (no constraint) if its box reaches the near plane.
+    static glm::vec2 windowDepthRange(const SceneObjects& objects, NodeRef ref, const Camera& camera,
+                                      const glm::mat4& viewProj);
 
     struct GpuModel {
         std::uint32_t vao = 0, vbo = 0, ibo = 0;
@@ -80,6 +88,8 @@ private:
     std::vector<NodeRef> candidates_;
     std::vector<std::uint32_t> ids_;
     std::vector<std::uint32_t> counts_;
+    std::vector<float> depths_;        // last ID pass depth, GL rows (bottom-up)
+    std::vector<glm::vec2> depthRange_;  // per candidate: windowDepthRange
     double lastMs_ = 0.0;
 };
 
