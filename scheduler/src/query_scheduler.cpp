@@ -85,9 +85,11 @@ FrameStats QueryScheduler::cullFrame(const TwoLevelTree& tree, const Camera& cam
         (drawnMap_.tilesX() - 1) * params_.occupancyTileSize >= width) {
         drawnMap_.reset(width, height, params_.occupancyTileSize);
         pendingMap_.reset(width, height, params_.occupancyTileSize);
+        waitingMap_.reset(width, height, params_.occupancyTileSize);
     } else {
         drawnMap_.clear();
         pendingMap_.clear();
+        waitingMap_.clear();
     }
     const std::uint32_t slots = tree.objects().slotCount();
     if (stillSince_.size() < slots) {
@@ -447,12 +449,43 @@ void QueryScheduler::runFull() {
         return true;
     };
 
+    // Nodes waiting for a query, nearest first. A waiting node blocks every farther node
+    // whose rectangle overlaps it (waitingMap_), not only pending queries do: otherwise a
+    // farther node would be queried before a nearer occluder in front of it is drawn, and
+    // drawn for nothing.
     struct Deferred {
+        float dist2;  // squared distance from the eye to the box centre
         NodeRef ref;
         Aabb box;
         ScreenRect rect;
     };
     std::vector<Deferred> deferred;
+    const glm::dvec3 eye(camera_.position);
+    auto defer = [&](NodeRef ref, const Aabb& box, const ScreenRect& rect) {
+        const glm::vec3 d = glm::vec3(glm::dvec3(box.center()) - eye);
+        const Deferred w{glm::dot(d, d), ref, box, rect};
+        auto at = std::upper_bound(deferred.begin(), deferred.end(), w.dist2,
+                                   [](float v, const Deferred& e) { return v < e.dist2; });
+        deferred.insert(at, w);
+        waitingMap_.mark(rect);
+    };
+    const bool keepOrder = !params_.batchOverlapping;
+    // Occupancy-map fast accept: a rectangle touching screen area where nothing has been
+    // drawn cannot be hidden. Tested as soon as a node is reached, even if a nearer waiting
+    // node overlaps it: deferring the test too was measured slower (three times the
+    // waiting for 3% fewer parts drawn, 800-triangle bunny parts).
+    auto occupancyAccept = [&](NodeRef ref, const Aabb& box, const ScreenRect& rect) -> bool {
+        if (!params_.useOccupancyAccept || drawnMap_.allSet(rect)) return false;
+        ++stats_->skippedByOccupancy;
+        NodeHistory& h = history_.at(ref, objs);
+        history_.recordAnswer(h, true, frame_);
+        trace(ref, box, NodeState::VisibleOccupancy);
+        closeBatch();
+        processVisible(ref, h);
+        return true;
+    };
+
+    waitingMap_.clear();
     collectLatent(false);
 
     while (!active_.empty() || !deferred.empty() || !pending_.empty()) {
@@ -490,16 +523,11 @@ void QueryScheduler::runFull() {
             }
             ScreenRect rect;
             projectRect(box, rect);
-            if (params_.useOccupancyAccept && !drawnMap_.allSet(rect)) {
-                // Touches screen area where nothing has been drawn: nothing can hide it.
-                ++stats_->skippedByOccupancy;
-                history_.recordAnswer(h, true, frame_);
-                trace(ref, box, NodeState::VisibleOccupancy);
-                closeBatch();
-                processVisible(ref, h);
-                continue;
-            }
-            if (params_.useLastFrameResults) {
+            if (occupancyAccept(ref, box, rect)) continue;
+            if (!params_.useLastFrameResults) {
+                if ((keepOrder && !deferred.empty() && waitingMap_.anySet(rect)) || !tryIssue(ref, box, rect))
+                    defer(ref, box, rect);
+            } else {
                 // Approximate: act on the previous answer now, read this query next frame.
                 if (!h.queryInFlight) {
                     openBatch();
@@ -516,20 +544,25 @@ void QueryScheduler::runFull() {
                 trace(ref, box, NodeState::VisibleQueried);
                 closeBatch();
                 processVisible(ref, h);
-                continue;
             }
-            if (!tryIssue(ref, box, rect)) deferred.push_back({ref, box, rect});
         }
 
-        // 3. Retry deferred nodes in order (the drawn map only fills up, so the occupancy
-        // accept cannot newly succeed; only the pending rectangles and the limit matter).
-        for (std::size_t i = 0; i < deferred.size() && pending_.size() < params_.maxQueriesInFlight;) {
-            if (tryIssue(deferred[i].ref, deferred[i].box, deferred[i].rect)) {
-                deferred.erase(deferred.begin() + static_cast<std::ptrdiff_t>(i));
-                progress = true;
-            } else {
-                ++i;
+        // 3. Retry waiting nodes nearest first; each one still waiting blocks the farther
+        // ones it overlaps. (The drawn map only fills up, so the occupancy accept, tested
+        // before a node waits, cannot newly succeed.)
+        if (!deferred.empty()) {
+            waitingMap_.clear();
+            std::size_t kept = 0;  // compacts in place, keeping the order
+            for (const Deferred& d : deferred) {
+                const bool blocked = keepOrder && waitingMap_.anySet(d.rect);
+                if (!blocked && tryIssue(d.ref, d.box, d.rect)) {
+                    progress = true;
+                } else {
+                    waitingMap_.mark(d.rect);
+                    deferred[kept++] = d;
+                }
             }
+            deferred.resize(kept);
         }
         closeBatch();
 

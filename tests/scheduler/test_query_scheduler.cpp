@@ -285,6 +285,43 @@ TEST(QueryScheduler, BatchesHoldOnlyNonOverlappingRectangles) {
     EXPECT_GT(multi, 0) << "expected some batches with several queries";
 }
 
+TEST(QueryScheduler, AFartherNodeNeverOvertakesAWaitingNearerNodeItOverlaps) {
+    // Three cubes seen from the origin: P nearest; A behind, overlapping P on screen (so A
+    // waits for P's query); F farthest, overlapping A but not P. F must wait for A too:
+    // queried before A's answer, F would be tested against a depth buffer still missing A.
+    SceneObjects objects;
+    const ModelId cube = objects.addModel(cubeModel(0.4f));
+    const glm::vec3 at[3] = {{0.0f, 0.0f, -3.0f}, {1.0f, 0.0f, -5.0f}, {2.0f, 0.0f, -7.0f}};
+    for (const glm::vec3& p : at) {
+        Transform t;
+        t.translation = p;
+        ASSERT_TRUE(objects.addObject(cube, t).ok());
+    }
+    LooseBsp bsp;
+    bsp.build(objects);
+    ScriptedBackend b;
+    b.latency = 2;
+    SchedulerParams p;
+    p.useOccupancyAccept = false;  // an empty screen would accept everything
+    p.occupancyTileSize = 8;
+    QueryScheduler sched(p);
+    RecordingSink sink;
+    TwoLevelTree tree(bsp, objects);
+    sched.cullFrame(tree, frontCamera(), 640, 320, b, sink);
+    EXPECT_EQ(sink.drawn.size(), 3u);
+    // Issue order of the three cube queries (the scene root's box is larger).
+    std::vector<int> order;
+    for (const auto& q : b.queries) {
+        glm::vec3 c(0.0f);
+        for (const glm::vec3& v : q.v.points()) c += v / 8.0f;
+        for (int i = 0; i < 3; ++i)
+            if (glm::length(c - at[i]) < 1e-3f && std::abs(q.v.points()[7].x - q.v.points()[0].x - 0.8f) < 1e-3f)
+                order.push_back(i);
+    }
+    ASSERT_EQ(order.size(), 3u);
+    EXPECT_EQ(order, (std::vector<int>{0, 1, 2}));
+}
+
 TEST(QueryScheduler, ParamsAreValidated) {
     SchedulerParams p;
     EXPECT_TRUE(validateSchedulerParams(p).ok());

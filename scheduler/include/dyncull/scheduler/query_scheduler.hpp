@@ -151,7 +151,7 @@ private:
 
     SchedulerParams params_;
     VisibilityHistory history_;
-    OccupancyMap drawnMap_, pendingMap_;
+    OccupancyMap drawnMap_, pendingMap_, waitingMap_;  // waiting: rects of nodes deferred this frame
     std::uint32_t frame_ = 0;
     std::uint32_t frontBudget_ = 0, frontLeavesSeen_ = 0;  // frontPercent, this frame
     std::vector<std::uint32_t> stillSince_;  // per object slot: first frame of its current transform (seen lazily)
