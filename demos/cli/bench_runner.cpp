@@ -305,7 +305,12 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
         const ModeSpec& spec = result_.modes[m];
         engine_.setQueryParams(spec.queries);
         recorder_.clear();
-        row[m].stats = spec.oracle ? engine_.renderParts(oracleParts_) : engine_.renderFrame(*schedulers_[m]);
+        auto rendered = spec.oracle ? engine_.renderParts(oracleParts_) : engine_.renderFrame(*schedulers_[m]);
+        if (!rendered) {
+            engine_.setPartObserver(nullptr);
+            return Error{"frame " + std::to_string(frame) + ", mode " + spec.name + ": " + rendered.error().message};
+        }
+        row[m].stats = *rendered;
         row[m].parts = compareParts(truth_, recorder_.drawn());
         images_[m] = engine_.renderer().readPixels();
         auto diff = compareImages(images_[m], images_[0]);

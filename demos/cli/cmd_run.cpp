@@ -116,7 +116,9 @@ void runRun(RunOptions o) {
         if (Status s = scene.update(engine, frame); !s) fail(s.message());
         if (Status s = engine.setCamera(scene.camera(frame, aspect)); !s) fail(s.message());
         if (boxView) boxView->trace(engine.scheduler(), true);
-        const FrameStats st = engine.renderFrame();
+        auto rendered = engine.renderFrame();
+        if (!rendered) fail("frame " + std::to_string(frame) + ": " + rendered.error().message);
+        const FrameStats& st = *rendered;
         if (boxView) drawNodeBoxOverlay(*boxView, engine, st, o.mode);
         writeCsvRow(csv, frame, st);
         ms += st.frameMs;

@@ -65,7 +65,11 @@ void runView(const ViewOptions& o) {
 
     std::vector<MeshId> ids;
     ids.reserve(scene.meshes.size());
-    for (const Mesh& m : scene.meshes) ids.push_back(renderer.upload(m));
+    for (const Mesh& m : scene.meshes) {
+        auto id = renderer.upload(m);
+        if (!id) fail(o.file + ": " + id.error().message);
+        ids.push_back(*id);
+    }
     renderer.finish();
     const double uploadMs = sw.lap();
 

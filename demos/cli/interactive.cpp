@@ -137,7 +137,9 @@ Status InteractiveViewer::step(const InputFrame& input, double dtSeconds) {
 
     QueryScheduler& scheduler = *schedulers_[static_cast<int>(state_.mode)];
     view_.trace(scheduler, state_.boxes);
-    state_.last = engine_.renderFrame(scheduler);
+    auto rendered = engine_.renderFrame(scheduler);
+    if (!rendered) return Error{rendered.error().message};
+    state_.last = *rendered;
     view_.trace(scheduler, false);
     state_.boxesDrawn = state_.boxes ? view_.drawBoxes(engine_, state_.filter) : 0;
     if (options_.text) {

@@ -103,12 +103,26 @@ public:
             if (!hasExtension(ext, "EGL_KHR_no_config_context")) return "no OpenGL pbuffer config";
             config = EGL_NO_CONFIG_KHR;
         }
-        const EGLint contextAttribs[] = {EGL_CONTEXT_MAJOR_VERSION, o.glMajor,
-                                         EGL_CONTEXT_MINOR_VERSION, o.glMinor,
-                                         EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
-                                         EGL_CONTEXT_OPENGL_DEBUG, o.debug ? EGL_TRUE : EGL_FALSE,
-                                         EGL_NONE};
-        context_ = eglCreateContext(dpy, config, EGL_NO_CONTEXT, contextAttribs);
+        std::vector<EGLint> attribs = {EGL_CONTEXT_MAJOR_VERSION, o.glMajor,
+                                       EGL_CONTEXT_MINOR_VERSION, o.glMinor,
+                                       EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                                       EGL_CONTEXT_OPENGL_DEBUG, o.debug ? EGL_TRUE : EGL_FALSE};
+        // Robust context with reset notification, so a GPU reset shows up in
+        // glGetGraphicsResetStatus instead of as undefined behaviour: EGL 1.5 core
+        // attributes, else EGL_EXT_create_context_robustness; a driver that refuses gets
+        // a plain context (GlContext::resetNotification() says which).
+        std::vector<EGLint> robust = attribs;
+        if (major > 1 || (major == 1 && minor >= 5)) {
+            robust.insert(robust.end(), {EGL_CONTEXT_OPENGL_ROBUST_ACCESS, EGL_TRUE,
+                                         EGL_CONTEXT_OPENGL_RESET_NOTIFICATION_STRATEGY, EGL_LOSE_CONTEXT_ON_RESET});
+        } else if (hasExtension(eglQueryString(dpy, EGL_EXTENSIONS), "EGL_EXT_create_context_robustness")) {
+            robust.insert(robust.end(), {EGL_CONTEXT_OPENGL_ROBUST_ACCESS_EXT, EGL_TRUE,
+                                         EGL_CONTEXT_OPENGL_RESET_NOTIFICATION_STRATEGY_EXT, EGL_LOSE_CONTEXT_ON_RESET_EXT});
+        }
+        attribs.push_back(EGL_NONE);
+        robust.push_back(EGL_NONE);
+        if (robust.size() > attribs.size()) context_ = eglCreateContext(dpy, config, EGL_NO_CONTEXT, robust.data());
+        if (context_ == EGL_NO_CONTEXT) context_ = eglCreateContext(dpy, config, EGL_NO_CONTEXT, attribs.data());
         if (context_ == EGL_NO_CONTEXT)
             return failed(("eglCreateContext(OpenGL " + std::to_string(o.glMajor) + "." + std::to_string(o.glMinor) +
                            " core)").c_str());

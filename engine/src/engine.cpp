@@ -28,6 +28,7 @@ Engine::Engine(GlContext& context, const EngineOptions& options)
 
 Expected<std::unique_ptr<Engine>> Engine::create(GlContext& context, const EngineOptions& options) {
     if (Status s = validateSchedulerParams(options.scheduler); !s) return Error{s.message()};
+    if (Status s = context.checkReset(); !s) return Error{s.message()};
     std::unique_ptr<Engine> e(new Engine(context, options));
     auto renderer = Renderer::create(context);
     if (!renderer) return renderer.error();
@@ -46,11 +47,14 @@ Expected<ModelId> Engine::addModel(const Mesh& mesh, const LocalBspParams& param
     return addModel(bsp.take());
 }
 
-ModelId Engine::addModel(LocalBsp bsp) {
-    const MeshId mesh = renderer_->upload(bsp.mesh);
+Expected<ModelId> Engine::addModel(LocalBsp bsp) {
+    if (Status s = context_.checkReset(); !s) return Error{s.message()};
+    // Upload first: if the GPU refuses, nothing has been registered yet.
+    auto mesh = renderer_->upload(bsp.mesh);
+    if (!mesh) return mesh.error();
     const ModelId id = objects_.addModel(std::move(bsp));
     if (meshOfModel_.size() <= id) meshOfModel_.resize(id + 1);
-    meshOfModel_[id] = mesh;
+    meshOfModel_[id] = *mesh;
     return id;
 }
 
@@ -98,7 +102,8 @@ LooseBspFrameStats Engine::updateSceneTree() {
     return tree_.update(objects_);
 }
 
-FrameStats Engine::renderFrame(QueryScheduler& scheduler) {
+Expected<FrameStats> Engine::renderFrame(QueryScheduler& scheduler) {
+    if (Status s = context_.checkReset(); !s) return Error{s.message()};
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();
     const double updateMs = updateSceneTree().updateMs;
@@ -110,12 +115,16 @@ FrameStats Engine::renderFrame(QueryScheduler& scheduler) {
     FrameStats st = scheduler.cullFrame(tree, camera_, size.x, size.y, *backend_, sink);
     renderer_->endFrame();
     if (finishEachFrame_) glFinish();
+    // A reset during the frame: its image and query results are undefined, so report it.
+    if (Status s = context_.checkReset(); !s) return Error{s.message()};
+    if (!backend_->frameStatus()) return Error{backend_->frameStatus().message()};
     st.updateMs = updateMs;
     st.frameMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
     return st;
 }
 
-FrameStats Engine::renderParts(const std::vector<NodeRef>& parts) {
+Expected<FrameStats> Engine::renderParts(const std::vector<NodeRef>& parts) {
+    if (Status s = context_.checkReset(); !s) return Error{s.message()};
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();
     const double updateMs = updateSceneTree().updateMs;
@@ -136,6 +145,7 @@ FrameStats Engine::renderParts(const std::vector<NodeRef>& parts) {
     st.nodesVisited = st.partsDrawn;
     renderer_->endFrame();
     if (finishEachFrame_) glFinish();
+    if (Status s = context_.checkReset(); !s) return Error{s.message()};
     st.updateMs = updateMs;
     st.frameMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
     return st;

@@ -2,6 +2,7 @@
 #include "dyncull/engine/gl_context.hpp"
 
 #include <cstdio>
+#include <string>
 
 #include <epoxy/gl.h>
 
@@ -50,8 +51,51 @@ void GlContext::initCommon(bool debug) {
             debug_ = true;
         }
     }
+    GLint strategy = 0;
+    glGetIntegerv(GL_RESET_NOTIFICATION_STRATEGY, &strategy);
+    resetNotification_ = strategy == GL_LOSE_CONTEXT_ON_RESET;
     while (glGetError() != GL_NO_ERROR) {
     }  // nothing the caller did yet: discard creation-time noise
+}
+
+Status GlContext::checkReset() {
+    if (lost_) return Error{lostMessage_};
+    ResetKind kind = faults_.simulateReset;
+    if (kind == ResetKind::None) {
+        // NO_ERROR on a context without reset notification, so calling it is always safe.
+        switch (glGetGraphicsResetStatus()) {
+            case GL_GUILTY_CONTEXT_RESET: kind = ResetKind::Guilty; break;
+            case GL_INNOCENT_CONTEXT_RESET: kind = ResetKind::Innocent; break;
+            case GL_UNKNOWN_CONTEXT_RESET: kind = ResetKind::Unknown; break;
+            default: return {};
+        }
+    }
+    const char* why = kind == ResetKind::Guilty     ? "guilty reset: this context's commands caused it"
+                      : kind == ResetKind::Innocent ? "innocent reset: another context caused it"
+                                                    : "unknown reset: the driver gives no cause";
+    lost_ = true;
+    lostMessage_ = std::string("OpenGL context lost (") + why + "); recreate the GlContext and the Engine";
+    return Error{lostMessage_};
+}
+
+Status GlContext::checkAllocation(const std::string& what, std::size_t bytes) {
+    bool outOfMemory = false;
+    for (int guard = 0; guard < 64; ++guard) {  // as in checkErrors: bounded on a lost context
+        const GLenum e = glGetError();
+        if (e == GL_NO_ERROR) break;
+        if (e == GL_OUT_OF_MEMORY) outOfMemory = true;  // still a GL error: counted like any other
+        if (debug_) continue;
+        ++errorCount_;
+        if (errorCount_ <= 20) std::fprintf(stderr, "GL error 0x%04x\n", static_cast<unsigned>(e));
+    }
+    if (faults_.allocationsBeforeFailure > 0) {
+        --faults_.allocationsBeforeFailure;
+    } else if (faults_.failBufferAllocations > 0) {
+        --faults_.failBufferAllocations;
+        outOfMemory = true;
+    }
+    if (!outOfMemory) return {};
+    return Error{"out of GPU memory " + what + " (" + std::to_string(bytes) + " bytes)"};
 }
 
 std::uint64_t GlContext::checkErrors() {

@@ -50,12 +50,19 @@ Expected<std::unique_ptr<GlQueryBackend>> GlQueryBackend::create(GlContext& cont
     // arrays over the same vertex stream, so the box path stays one upload and one draw.
     glCreateBuffers(1, &b->boxIbo_);
     glNamedBufferStorage(b->boxIbo_, sizeof(kBoxTriangles), kBoxTriangles.data(), 0);
+    if (Status st = context.checkAllocation("creating the query box index buffer", sizeof(kBoxTriangles)); !st)
+        return Error{"query backend: " + st.message()};
     glCreateBuffers(1, &b->meshIbo_);
-    b->iboCapacity_ = kInitialIndices;
-    glNamedBufferData(b->meshIbo_, b->iboCapacity_, nullptr, GL_STREAM_DRAW);
     glCreateBuffers(1, &b->vbo_);
+    b->iboCapacity_ = kInitialIndices;
     b->vboCapacity_ = kInitialVertices;
+    // On failure the destructor deletes what was created.
+    glNamedBufferData(b->meshIbo_, b->iboCapacity_, nullptr, GL_STREAM_DRAW);
+    if (Status st = context.checkAllocation("creating the query volume index buffer", b->iboCapacity_); !st)
+        return Error{"query backend: " + st.message()};
     glNamedBufferData(b->vbo_, b->vboCapacity_ * sizeof(glm::vec3), nullptr, GL_STREAM_DRAW);
+    if (Status st = context.checkAllocation("creating the query volume vertex buffer", b->vboCapacity_ * sizeof(glm::vec3)); !st)
+        return Error{"query backend: " + st.message()};
     glCreateVertexArrays(1, &b->boxVao_);
     glCreateVertexArrays(1, &b->meshVao_);
     for (std::uint32_t vao : {b->boxVao_, b->meshVao_}) {
@@ -83,10 +90,38 @@ void GlQueryBackend::beginFrame(const Camera& camera, int, int) {
     viewProj_ = camera.viewProjectionRelative();
     eye_ = glm::dvec3(camera.position);
     // Orphan last frame's volumes so writing this frame's never waits on the rasteriser.
-    glNamedBufferData(vbo_, vboCapacity_ * sizeof(glm::vec3), nullptr, GL_STREAM_DRAW);
+    // After a failed allocation both buffers are allocated again (either may have no storage).
+    const bool retry = degraded_;
+    degraded_ = false;
+    frameStatus_ = {};
     vboUsed_ = 0;
-    if (iboUsed_ > 0) glNamedBufferData(meshIbo_, iboCapacity_, nullptr, GL_STREAM_DRAW);
+    if (allocate(vbo_, vboCapacity_ * sizeof(glm::vec3), "orphaning the query volume vertex buffer") &&
+        (iboUsed_ > 0 || retry))
+        allocate(meshIbo_, iboCapacity_, "orphaning the query volume index buffer");
     iboUsed_ = 0;
+}
+
+bool GlQueryBackend::allocate(std::uint32_t buffer, std::size_t bytes, const char* what) {
+    glNamedBufferData(buffer, static_cast<GLsizeiptr>(bytes), nullptr, GL_STREAM_DRAW);
+    if (Status st = context_.checkAllocation(what, bytes); !st) {
+        degraded_ = true;
+        frameStatus_ = Error{"query backend: " + st.message() + "; queries counted visible until it succeeds"};
+        return false;
+    }
+    return true;
+}
+
+QueryId GlQueryBackend::acquireSlot() {
+    if (!free_.empty()) {
+        const QueryId id = free_.back();
+        free_.pop_back();
+        return id;
+    }
+    const QueryId id = static_cast<QueryId>(queries_.size());
+    queries_.emplace_back();
+    glCreateQueries(GL_ANY_SAMPLES_PASSED_CONSERVATIVE, 1, &queries_[id].name);
+    queries_[id].target = GL_ANY_SAMPLES_PASSED_CONSERVATIVE;
+    return id;
 }
 
 void GlQueryBackend::beginBatch() {
@@ -117,16 +152,26 @@ QueryId GlQueryBackend::issue(const QueryVolume& volume) {
     assert(volume.vertexCount <= QueryVolume::kMaxVertices && volume.triangleCount <= QueryVolume::kMaxTriangles);
     assert(!volume.isBox() || volume.vertexCount == 8);
     const std::uint32_t nv = volume.vertexCount, ni = 3 * volume.triangleCount;
-    if (vboUsed_ + nv > vboCapacity_) {
-        // Grow: earlier draws of this frame keep the orphaned storage they referenced.
+    // Grow by doubling: earlier draws of this frame keep the orphaned storage they
+    // referenced. On failure the capacity stays at the last size that worked.
+    if (!degraded_ && vboUsed_ + nv > vboCapacity_ &&
+        allocate(vbo_, std::size_t{2} * vboCapacity_ * sizeof(glm::vec3), "growing the query volume vertex buffer")) {
         vboCapacity_ *= 2;
-        glNamedBufferData(vbo_, vboCapacity_ * sizeof(glm::vec3), nullptr, GL_STREAM_DRAW);
         vboUsed_ = 0;
     }
-    if (iboUsed_ + ni > iboCapacity_) {
+    if (!degraded_ && iboUsed_ + ni > iboCapacity_ &&
+        allocate(meshIbo_, std::size_t{2} * iboCapacity_, "growing the query volume index buffer")) {
         iboCapacity_ *= 2;
-        glNamedBufferData(meshIbo_, iboCapacity_, nullptr, GL_STREAM_DRAW);
         iboUsed_ = 0;
+    }
+    if (degraded_) {
+        // No buffer to draw the volume from: answer Visible at once (never culls, never waits).
+        const QueryId id = acquireSlot();
+        Slot& s = queries_[id];
+        s.live = true;
+        s.result = QueryResult::Visible;
+        s.samples = 0;
+        return id;
     }
     // Vertices relative to the eye, each pushed away from the volume's centre by the float
     // rounding its world coordinates may carry (2^-22 of the largest magnitude, i.e. 2 ulp):
@@ -157,16 +202,7 @@ QueryId GlQueryBackend::issue(const QueryVolume& volume) {
         glBindVertexArray(boundMesh_ ? meshVao_ : boxVao_);
     }
 
-    QueryId id;
-    if (!free_.empty()) {
-        id = free_.back();
-        free_.pop_back();
-    } else {
-        id = static_cast<QueryId>(queries_.size());
-        queries_.emplace_back();
-        glCreateQueries(GL_ANY_SAMPLES_PASSED_CONSERVATIVE, 1, &queries_[id].name);
-        queries_[id].target = GL_ANY_SAMPLES_PASSED_CONSERVATIVE;
-    }
+    const QueryId id = acquireSlot();
     Slot& s = queries_[id];
     const std::uint32_t target = params_.visiblePixelThreshold > 0 ? GL_SAMPLES_PASSED : GL_ANY_SAMPLES_PASSED_CONSERVATIVE;
     if (s.target != target) {

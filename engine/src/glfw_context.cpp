@@ -67,7 +67,15 @@ Expected<std::unique_ptr<GlContext>> createGlfwContext(const ContextOptions& o) 
     glfwWindowHint(GLFW_OPENGL_DEBUG_CONTEXT, o.debug ? GLFW_TRUE : GLFW_FALSE);
     glfwWindowHint(GLFW_VISIBLE, o.visible ? GLFW_TRUE : GLFW_FALSE);
     glfwWindowHint(GLFW_DEPTH_BITS, 24);
+    // Robust context with reset notification where the driver offers it (see
+    // GlContext::resetNotification); otherwise the same window without.
+    glfwWindowHint(GLFW_CONTEXT_ROBUSTNESS, GLFW_LOSE_CONTEXT_ON_RESET);
     ctx->window_ = glfwCreateWindow(o.width, o.height, o.title.c_str(), nullptr, nullptr);
+    if (!ctx->window_) {
+        glfwWindowHint(GLFW_CONTEXT_ROBUSTNESS, GLFW_NO_ROBUSTNESS);
+        lastGlfwError().clear();
+        ctx->window_ = glfwCreateWindow(o.width, o.height, o.title.c_str(), nullptr, nullptr);
+    }
     if (!ctx->window_)
         return Error{"GLFW: window with OpenGL " + std::to_string(o.glMajor) + "." + std::to_string(o.glMinor) +
                      " core context: " + lastGlfwError()};

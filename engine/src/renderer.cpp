@@ -3,6 +3,7 @@
 
 #include <cassert>
 #include <cmath>
+#include <string>
 
 #include <epoxy/gl.h>
 #include <glm/gtc/matrix_inverse.hpp>
@@ -38,7 +39,7 @@ Renderer::~Renderer() {
     if (program_) glDeleteProgram(program_);
 }
 
-MeshId Renderer::upload(const Mesh& mesh) {
+Expected<MeshId> Renderer::upload(const Mesh& mesh) {
     assert(validateMesh(mesh).empty());
     Mesh withNormals;
     const Mesh* src = &mesh;
@@ -57,11 +58,25 @@ MeshId Renderer::upload(const Mesh& mesh) {
     g.indexCount = static_cast<std::uint32_t>(src->indices.size());
     const GLsizeiptr vbytes = static_cast<GLsizeiptr>(interleaved.size() * sizeof(glm::vec3));
     const GLsizeiptr ibytes = static_cast<GLsizeiptr>(src->indices.size() * sizeof(std::uint32_t));
+    const std::string what = "uploading mesh " + (mesh.name.empty() ? std::string("(unnamed)") : "'" + mesh.name + "'");
+    const std::size_t totalBytes = static_cast<std::size_t>(vbytes + ibytes);
+    auto discard = [&g] {  // a failed upload keeps nothing
+        glDeleteBuffers(1, &g.vbo);
+        glDeleteBuffers(1, &g.ibo);  // 0 (not yet created) is ignored
+    };
     glCreateBuffers(1, &g.vbo);
     // Storage must be non-zero sized; an empty mesh still gets valid (1-byte) buffers.
     glNamedBufferStorage(g.vbo, vbytes ? vbytes : 1, vbytes ? interleaved.data() : nullptr, 0);
+    if (Status s = context_.checkAllocation(what, totalBytes); !s) {
+        discard();
+        return Error{s.message()};
+    }
     glCreateBuffers(1, &g.ibo);
     glNamedBufferStorage(g.ibo, ibytes ? ibytes : 1, ibytes ? src->indices.data() : nullptr, 0);
+    if (Status s = context_.checkAllocation(what, totalBytes); !s) {
+        discard();
+        return Error{s.message()};
+    }
     glCreateVertexArrays(1, &g.vao);
     glVertexArrayVertexBuffer(g.vao, 0, g.vbo, 0, 2 * sizeof(glm::vec3));
     glVertexArrayElementBuffer(g.vao, g.ibo);
@@ -71,7 +86,7 @@ MeshId Renderer::upload(const Mesh& mesh) {
     glEnableVertexArrayAttrib(g.vao, 1);
     glVertexArrayAttribFormat(g.vao, 1, 3, GL_FLOAT, GL_FALSE, sizeof(glm::vec3));
     glVertexArrayAttribBinding(g.vao, 1, 0);
-    uploadedBytes_ += static_cast<std::size_t>(vbytes + ibytes);
+    uploadedBytes_ += totalBytes;
     meshes_.push_back(g);
     return static_cast<MeshId>(meshes_.size() - 1);
 }

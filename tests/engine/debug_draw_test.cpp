@@ -58,7 +58,7 @@ TEST(DebugDraw, DepthModesHideOrFadeLinesBehindGeometry) {
         ASSERT_TRUE(r.ok()) << r.error().message;
         DebugDraw lines;
         const Camera cam = test::cameraOnZ(3.0f);
-        const MeshId wall = (*r)->upload(test::quadMesh(2.0f));  // z = 0 plane, covers the view centre
+        const MeshId wall = *(*r)->upload(test::quadMesh(2.0f));  // z = 0 plane, covers the view centre
         // A box behind the wall.
         const Aabb box = Aabb::fromMinMax({-0.3f, -0.3f, -1.5f}, {0.3f, 0.3f, -1.0f});
         const glm::ivec2 size = ctx->size();

@@ -108,7 +108,7 @@ TEST_F(QuadAndCube, DrawnPartsAreComparedWithTheTruth) {
     EXPECT_EQ(none.falseNegativePixels, vs.coveredPixels);
     // The oracle path draws exactly the visible set and gives the same picture as vfc.
     const Image vfcImage = engine->renderer().readPixels();
-    const FrameStats st = engine->renderParts({{quad.index, 0}});
+    const FrameStats st = *engine->renderParts({{quad.index, 0}});
     EXPECT_EQ(st.partsDrawn, 1u);
     EXPECT_EQ(engine->renderer().readPixels().rgba, vfcImage.rgba);
     EXPECT_EQ(ctx->checkErrors(), 0u);
@@ -132,8 +132,8 @@ TEST(GroundTruthArtefacts, FragmentsOutsideTheirBoxDepthRangeAreNotCounted) {
     ASSERT_EQ(shifted.nodes.size(), 1u);
     shifted.nodes[0].box.min.z -= 2.0f;  // the quad (z = 0) lies in front of [-2, -2 + thickness]
     shifted.nodes[0].box.max.z -= 2.0f;
-    const ModelId good = engine->addModel(honest.take());
-    const ModelId bad = engine->addModel(std::move(shifted));
+    const ModelId good = *engine->addModel(honest.take());
+    const ModelId bad = *engine->addModel(std::move(shifted));
     const ObjectHandle a = *engine->addObject(good, at({-1.2f, 0, 0}));
     const ObjectHandle b = *engine->addObject(bad, at({1.2f, 0, 0}));
     ASSERT_TRUE(engine->setCamera(cameraOnZ(4.0f)).ok());

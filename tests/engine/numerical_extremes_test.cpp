@@ -77,10 +77,10 @@ struct Rig {
     Result frame(const Camera& camera) {
         Result r;
         EXPECT_TRUE(engine->setCamera(camera).ok());
-        r.vfcStats = engine->renderFrame(vfc);
+        r.vfcStats = *engine->renderFrame(vfc);
         r.vfcImage = engine->renderer().readPixels();
         recorder.clear();
-        r.fullStats = engine->renderFrame(full);
+        r.fullStats = *engine->renderFrame(full);
         r.fullImage = engine->renderer().readPixels();
         auto d = compareImages(r.vfcImage, r.fullImage);
         EXPECT_TRUE(d.ok());

@@ -28,7 +28,7 @@ TEST(OcclusionQuery, HiddenBoxZeroVisibleBoxOne) {
     auto made = Renderer::create(*ctx);
     ASSERT_TRUE(made.ok()) << made.error().message;
     Renderer& r = **made;
-    const MeshId wall = r.upload(test::quadMesh(5.0f));  // fills the whole view at z = 0
+    const MeshId wall = *r.upload(test::quadMesh(5.0f));  // fills the whole view at z = 0
     r.beginFrame(test::cameraOnZ(3.0f));
     r.drawMesh(wall, glm::mat4(1.0f), {0.5f, 0.5f, 0.5f});
     const glm::u8vec4 before = r.readPixels().at(32, 32);

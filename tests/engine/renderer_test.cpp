@@ -26,7 +26,7 @@ struct RendererTest : ::testing::Test {
 };
 
 TEST_F(RendererTest, RedQuadFillsTheCentre) {
-    const MeshId quad = renderer->upload(test::quadMesh(0.5f));
+    const MeshId quad = *renderer->upload(test::quadMesh(0.5f));
     renderer->beginFrame(test::cameraOnZ(3.0f));
     renderer->drawMesh(quad, glm::mat4(1.0f), {1, 0, 0});
     renderer->endFrame();
@@ -51,7 +51,7 @@ TEST_F(RendererTest, RedQuadFillsTheCentre) {
 }
 
 TEST_F(RendererTest, ReadPixelsIsTopDown) {
-    const MeshId quad = renderer->upload(test::quadMesh(0.3f));
+    const MeshId quad = *renderer->upload(test::quadMesh(0.3f));
     renderer->beginFrame(test::cameraOnZ(3.0f));
     renderer->drawMesh(quad, glm::translate(glm::mat4(1.0f), {0, 0.9f, 0}), {0, 0, 1});  // world up
     renderer->endFrame();
@@ -61,7 +61,7 @@ TEST_F(RendererTest, ReadPixelsIsTopDown) {
 }
 
 TEST_F(RendererTest, NearCubeHidesFarCubeRegardlessOfOrder) {
-    const MeshId cube = renderer->upload(test::cubeMesh(1.0f));
+    const MeshId cube = *renderer->upload(test::cubeMesh(1.0f));
     const glm::mat4 nearM = glm::scale(glm::mat4(1.0f), glm::vec3(0.5f));
     const glm::mat4 farM = glm::scale(glm::translate(glm::mat4(1.0f), {0, 0, -3}), glm::vec3(1.5f));
     renderer->beginFrame(test::cameraOnZ(3.0f));
@@ -80,7 +80,7 @@ TEST_F(RendererTest, NearCubeHidesFarCubeRegardlessOfOrder) {
 }
 
 TEST_F(RendererTest, SubRangeDrawsOnlyThoseTriangles) {
-    const MeshId quad = renderer->upload(test::quadMesh(0.5f));
+    const MeshId quad = *renderer->upload(test::quadMesh(0.5f));
     renderer->beginFrame(test::cameraOnZ(3.0f));
     renderer->drawRange(quad, 3, 3, glm::mat4(1.0f), {1, 1, 1});  // second triangle: (0, 2, 3), upper-left half
     renderer->endFrame();
@@ -91,7 +91,7 @@ TEST_F(RendererTest, SubRangeDrawsOnlyThoseTriangles) {
 }
 
 TEST_F(RendererTest, LightingShadesFacesDifferently) {
-    const MeshId sphere = renderer->upload(test::sphereMesh(1.0f));
+    const MeshId sphere = *renderer->upload(test::sphereMesh(1.0f));
     renderer->beginFrame(test::cameraOnZ(4.0f));
     renderer->drawMesh(sphere, glm::mat4(1.0f), {0.8f, 0.8f, 0.8f});
     renderer->endFrame();
@@ -105,7 +105,7 @@ TEST_F(RendererTest, LightingShadesFacesDifferently) {
 TEST_F(RendererTest, MissingNormalsAreComputedOnUpload) {
     Mesh m = test::quadMesh(0.5f);
     m.normals.clear();
-    const MeshId id = renderer->upload(m);
+    const MeshId id = *renderer->upload(m);
     EXPECT_EQ(renderer->indexCount(id), 6u);
     renderer->beginFrame(test::cameraOnZ(3.0f));
     renderer->drawMesh(id, glm::mat4(1.0f), {1, 0, 0});

@@ -105,7 +105,9 @@ TEST(Soak, TenThousandFramesOfAMovingSwarm) {
         ASSERT_TRUE(scene->update(engine, f).ok());
         ASSERT_TRUE(engine.setCamera(scene->camera(f, aspect)).ok());
         recorder.clear();
-        const FrameStats st = engine.renderFrame();
+        auto rendered = engine.renderFrame();
+        ASSERT_TRUE(rendered.ok()) << "frame " << f << ": " << rendered.error().message;
+        const FrameStats& st = *rendered;
         timedOut += st.queriesTimedOut;
         queries += st.queriesIssued;
         drawn += st.partsDrawn;

@@ -24,7 +24,7 @@ TEST(Window, RendersIntoDefaultFramebuffer) {
     EXPECT_EQ((*ctx)->size(), glm::ivec2(64, 48));
     auto r = Renderer::create(**ctx);
     ASSERT_TRUE(r.ok()) << r.error().message;
-    const MeshId quad = (*r)->upload(test::quadMesh(0.5f));
+    const MeshId quad = *(*r)->upload(test::quadMesh(0.5f));
     Camera cam;
     cam.position = {0, 0, 3};
     cam.aspect = 64.0f / 48.0f;

@@ -70,7 +70,11 @@ Expected<PreparedScene> prepareScene(GeneratedScene scene, unsigned threads, Pro
 Status populateEngine(Engine& engine, PreparedScene scene) {
     std::vector<ModelId> ids;
     ids.reserve(scene.models.size());
-    for (LocalBsp& bsp : scene.models) ids.push_back(engine.addModel(std::move(bsp)));
+    for (LocalBsp& bsp : scene.models) {
+        auto id = engine.addModel(std::move(bsp));
+        if (!id) return Error{id.error().message};
+        ids.push_back(*id);
+    }
     for (const PlacedObject& o : scene.objects) {
         if (o.model >= ids.size()) return Error{"scene: object refers to model " + std::to_string(o.model)};
         auto h = engine.addObject(ids[o.model], o.transform, o.isStatic);

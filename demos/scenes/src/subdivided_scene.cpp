@@ -74,8 +74,9 @@ public:
         }
         camera_ = builtinCameraScene(source_, options_);
         for (LocalBsp& leaf : leaves) {
-            const ModelId id = engine.addModel(std::move(leaf));
-            auto h = engine.addObject(id, Transform{}, true);
+            auto id = engine.addModel(std::move(leaf));
+            if (!id) return Error{id.error().message};
+            auto h = engine.addObject(*id, Transform{}, true);
             if (!h) return Error{h.error().message};
         }
         char line[512];

@@ -41,12 +41,16 @@ using PartObserver = std::function<void(std::uint32_t object, std::uint32_t firs
 /// Borrows the GL context (which must outlive the Engine and be current on calls).
 class Engine {
 public:
+    /// Errors: invalid scheduler parameters, shaders rejected by the driver, GPU out of
+    /// memory for the query volume buffers, or the context already lost.
     static Expected<std::unique_ptr<Engine>> create(GlContext& context, const EngineOptions& options = {});
 
     /// Builds the model's local BSP (object space) and uploads its split mesh once.
+    /// Errors: invalid mesh or parameters, GPU out of memory, context lost; on any error
+    /// the engine is exactly as before the call (no model, no buffers).
     Expected<ModelId> addModel(const Mesh& mesh, const LocalBspParams& params = {});
-    /// Adds a prebuilt local BSP (e.g. loaded from a cache).
-    ModelId addModel(LocalBsp bsp);
+    /// Adds a prebuilt local BSP (e.g. loaded from a cache); errors as above.
+    Expected<ModelId> addModel(LocalBsp bsp);
     Expected<ObjectHandle> addObject(ModelId model, const Transform& transform, bool isStatic = false);
     Status removeObject(ObjectHandle object);
     /// Rejects NaN/Inf, zero scale and non-unit rotations with an error; the object keeps its old transform.
@@ -62,14 +66,18 @@ public:
 
     /// One frame: relink moved objects, cull, draw, and glFinish (so frameMs bounds the
     /// GPU work too). Does not present; windowed callers call context().present().
-    FrameStats renderFrame() { return renderFrame(scheduler_); }
+    /// Errors: the GL context was lost (checked before and after the frame's GL work; from
+    /// then on every call returns the same error and does no GL work, see
+    /// GlContext::checkReset), or the query volume buffers could not be allocated (the
+    /// frame was still drawn, its unissued queries counted visible).
+    Expected<FrameStats> renderFrame() { return renderFrame(scheduler_); }
     /// The same with another scheduler (its own mode, parameters and visibility history),
     /// so several configurations can be run interleaved over the same frames of one scene.
-    FrameStats renderFrame(QueryScheduler& scheduler);
+    Expected<FrameStats> renderFrame(QueryScheduler& scheduler);
     /// Draws exactly `parts` (local-BSP nodes: object slot, node), in the given order, with
     /// no culling and no queries, timed like renderFrame (the oracle lower bound of `dyncull
-    /// bench`). Every ref must name a live object and a node of its model.
-    FrameStats renderParts(const std::vector<NodeRef>& parts);
+    /// bench`). Every ref must name a live object and a node of its model. Errors: context lost.
+    Expected<FrameStats> renderParts(const std::vector<NodeRef>& parts);
     /// Observer of drawn parts (nullptr removes it); see PartObserver.
     void setPartObserver(PartObserver observer) { observer_ = std::move(observer); }
     /// Relinks moved objects now (renderFrame does it too; calling twice costs nothing).

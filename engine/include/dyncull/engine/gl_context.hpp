@@ -30,6 +30,22 @@ struct ContextOptions {
     std::string title = "dyncull";  ///< windows only
 };
 
+/// Why glGetGraphicsResetStatus reported a reset (GL_GUILTY/INNOCENT/UNKNOWN_CONTEXT_RESET).
+enum class ResetKind : std::uint8_t { None, Guilty, Innocent, Unknown };
+
+/// Test-only fault injection: llvmpipe never loses a context and rarely runs out of
+/// memory, so tests/engine/gl_faults_test.cpp sets these to drive the error paths that a
+/// real GPU reset or GL_OUT_OF_MEMORY would take. Nothing in dyncull sets them; they are
+/// reachable only through GlContext::faultInjectionForTesting().
+struct GlFaultInjection {
+    /// checkReset() reports this reset as if glGetGraphicsResetStatus had returned it.
+    ResetKind simulateReset = ResetKind::None;
+    /// After `allocationsBeforeFailure` more checkAllocation() calls succeed, the next
+    /// `failBufferAllocations` report GL_OUT_OF_MEMORY (each call uses up one of either).
+    std::uint32_t allocationsBeforeFailure = 0;
+    std::uint32_t failBufferAllocations = 0;
+};
+
 /// Owns the native context (and, headless, its FBO). Not copyable. The context is made
 /// current on creation; GL calls must happen on the creating thread.
 class GlContext {
@@ -72,6 +88,22 @@ public:
     std::uint64_t glErrorCount() const { return errorCount_; }
     bool isDebug() const { return debug_; }
 
+    /// True if the driver granted a robust context with reset notification
+    /// LOSE_CONTEXT_ON_RESET (requested on every platform that offers it; the fallback is
+    /// a plain context, on which GL never reports resets).
+    bool resetNotification() const { return resetNotification_; }
+    /// Polls glGetGraphicsResetStatus (GL 4.5 core). After the first reset the context is
+    /// lost for good: every later call returns the same Error without touching GL, e.g.
+    /// "OpenGL context lost (innocent reset: ...); recreate the GlContext and the Engine".
+    Status checkReset();
+    bool lost() const { return lost_; }
+    /// Call right after a glNamedBufferStorage/glNamedBufferData: drains glGetError and
+    /// returns "out of GPU memory <what> (<bytes> bytes)" if it held GL_OUT_OF_MEMORY
+    /// (other errors are counted as in checkErrors).
+    Status checkAllocation(const std::string& what, std::size_t bytes);
+    /// See GlFaultInjection: for tests only.
+    GlFaultInjection& faultInjectionForTesting() { return faults_; }
+
 protected:
     friend Expected<std::unique_ptr<GlContext>> createEglContext(const ContextOptions&);
     friend Expected<std::unique_ptr<GlContext>> createGlfwContext(const ContextOptions&);
@@ -85,6 +117,10 @@ protected:
     std::string renderer_, version_, platform_;
     std::uint64_t errorCount_ = 0;
     bool debug_ = false;
+    bool resetNotification_ = false;
+    bool lost_ = false;
+    std::string lostMessage_;
+    GlFaultInjection faults_;
 };
 
 /// Headless EGL context with an RGBA8 + depth32F FBO of the requested size.

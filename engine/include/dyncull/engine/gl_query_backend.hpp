@@ -46,10 +46,19 @@ public:
     void setParams(const GlQueryParams& p) { params_ = p; }
     std::size_t poolSize() const { return queries_.size(); }
     std::size_t inUse() const { return queries_.size() - free_.size(); }
+    /// Error if the volume buffers could not be (re)allocated in the current frame
+    /// (GL_OUT_OF_MEMORY): from then until the next beginFrame every issue() returns a
+    /// query that is already Visible without touching GL (never culls, never waits), and
+    /// the next beginFrame allocates again at the last size that worked.
+    const Status& frameStatus() const { return frameStatus_; }
 
 private:
     GlQueryBackend(GlContext& context, GlQueryParams params) : context_(context), params_(params) {}
     QueryResult fetch(QueryId id);
+    QueryId acquireSlot();
+    /// (Re)allocates a streaming buffer with glNamedBufferData; on failure records the
+    /// error in frameStatus_ and enters the degraded state.
+    bool allocate(std::uint32_t buffer, std::size_t bytes, const char* what);
 
     struct Slot {
         std::uint32_t name = 0;  // GL query object
@@ -75,6 +84,8 @@ private:
     int savedDepthFunc_ = 0;
     bool savedCull_ = false, savedDepthTest_ = false;
     bool inBatch_ = false;
+    bool degraded_ = false;  // an allocation failed this frame: queries answer Visible
+    Status frameStatus_;
 };
 
 }  // namespace dyncull

@@ -41,8 +41,10 @@ public:
 
     /// Uploads positions + normals (interleaved) and indices once. Normals are computed
     /// if the mesh has none. The mesh must pass validateMesh (loaders guarantee it) and
-    /// have fewer than 2^32 indices.
-    MeshId upload(const Mesh& mesh);
+    /// have fewer than 2^32 indices. If the driver cannot allocate the buffers
+    /// (GL_OUT_OF_MEMORY) returns "out of GPU memory uploading mesh 'name' (N bytes)" and
+    /// keeps nothing: buffers made for it are deleted, meshCount() is unchanged.
+    Expected<MeshId> upload(const Mesh& mesh);
     std::uint32_t indexCount(MeshId id) const { return meshes_[id].indexCount; }
     std::size_t meshCount() const { return meshes_.size(); }
     /// GPU memory held by mesh buffers, bytes.
