@@ -486,6 +486,7 @@ void QueryScheduler::runFull() {
     };
 
     waitingMap_.clear();
+    bool answered = false;  // a query finished since waiting nodes were last retried
     collectLatent(false);
 
     while (!active_.empty() || !deferred.empty() || !pending_.empty()) {
@@ -502,7 +503,7 @@ void QueryScheduler::runFull() {
             Pending p = pending_[i];
             pending_.erase(pending_.begin() + static_cast<std::ptrdiff_t>(i));
             finishQuery(p, r);
-            progress = true;
+            progress = answered = true;
         }
 
         // 2. Process the active list front-to-back.
@@ -550,7 +551,10 @@ void QueryScheduler::runFull() {
         // 3. Retry waiting nodes nearest first; each one still waiting blocks the farther
         // ones it overlaps. (The drawn map only fills up, so the occupancy accept, tested
         // before a node waits, cannot newly succeed.)
-        if (!deferred.empty()) {
+        if (answered && !deferred.empty()) {
+            // Only an answer frees a rectangle or an in-flight slot; without one, every
+            // waiting node is still blocked.
+            answered = false;
             waitingMap_.clear();
             std::size_t kept = 0;  // compacts in place, keeping the order
             for (const Deferred& d : deferred) {
@@ -574,6 +578,7 @@ void QueryScheduler::runFull() {
             Pending p = pending_.front();
             pending_.erase(pending_.begin());
             finishQuery(p, r);
+            answered = true;
         }
     }
     closeBatch();
