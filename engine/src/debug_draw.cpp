@@ -9,6 +9,7 @@
 #include <epoxy/gl.h>
 #include <glm/gtc/type_ptr.hpp>
 
+#include "depth_convention.hpp"
 #include "shader_program.hpp"
 
 namespace dyncull {
@@ -36,7 +37,7 @@ uniform vec2 uViewport;
 uniform float uWidth;
 void main() {
     vec4 p0 = gl_in[0].gl_Position, p1 = gl_in[1].gl_Position;
-    float d0 = p0.z + p0.w, d1 = p1.z + p1.w;  // >= 0 in front of the near plane
+    float d0 = p0.w - p0.z, d1 = p1.w - p1.z;  // >= 0 in front of the near plane (reversed Z: z <= w)
     if (d0 < 0.0 && d1 < 0.0) return;
     if (d0 < 0.0) p0 = mix(p0, p1, d0 / (d0 - d1));
     if (d1 < 0.0) p1 = mix(p1, p0, d1 / (d1 - d0));
@@ -192,16 +193,16 @@ void DebugDraw::flush(const glm::mat4& viewProjection, glm::ivec2 viewportPixels
     glUniform1f(locWidth_, widthPixels);
     glBindVertexArray(vao_);
     switch (depth) {
-        case LineDepth::Tested: drawPass(GL_LEQUAL, 1.0f); break;
+        case LineDepth::Tested: drawPass(detail::kDepthNearerOrEqual, 1.0f); break;
         case LineDepth::Overlay: drawPass(GL_ALWAYS, 1.0f); break;
         case LineDepth::XRay:
-            drawPass(GL_GREATER, hiddenAlpha);
-            drawPass(GL_LEQUAL, 1.0f);
+            drawPass(detail::kDepthFarther, hiddenAlpha);
+            drawPass(detail::kDepthNearerOrEqual, 1.0f);
             break;
     }
     glDisable(GL_BLEND);
     glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
+    glDepthFunc(detail::kDepthNearer);
     glDepthMask(GL_TRUE);
     if (cull) glEnable(GL_CULL_FACE);
     vertices_.clear();

@@ -6,6 +6,7 @@
 
 #include <epoxy/gl.h>
 
+#include "depth_convention.hpp"
 #include "sanitizer_driver_pin.hpp"
 
 namespace dyncull {
@@ -54,6 +55,7 @@ void GlContext::initCommon(bool debug) {
     GLint strategy = 0;
     glGetIntegerv(GL_RESET_NOTIFICATION_STRATEGY, &strategy);
     resetNotification_ = strategy == GL_LOSE_CONTEXT_ON_RESET;
+    detail::useReversedDepth();  // the depth convention of Camera::projection, for every pass
     while (glGetError() != GL_NO_ERROR) {
     }  // nothing the caller did yet: discard creation-time noise
 }

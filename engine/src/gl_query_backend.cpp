@@ -19,6 +19,7 @@
 
 #include "dyncull/engine/gl_context.hpp"
 #include "dyncull/objects/convex_mesh.hpp"
+#include "depth_convention.hpp"
 #include "shader_program.hpp"
 
 namespace dyncull {
@@ -133,14 +134,17 @@ void GlQueryBackend::beginBatch() {
     glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
     glDepthMask(GL_FALSE);
     glEnable(GL_DEPTH_TEST);
-    // LEQUAL: a volume face coplanar with drawn geometry counts as visible (conservative).
-    glDepthFunc(GL_LEQUAL);
+    // Nearer-or-equal: a volume face coplanar with drawn geometry counts as visible (conservative).
+    glDepthFunc(detail::kDepthNearerOrEqual);
     glDisable(GL_CULL_FACE);
     // Pull volumes toward the eye by a few depth-buffer steps (scaled by GL to the face's
     // depth slope and the buffer's resolution): a part lying on its box face, or a
-    // coplanar occluder, must not win a depth tie against the volume and hide a visible pixel.
+    // coplanar occluder, must not win a depth tie against the volume and hide a visible
+    // pixel. Reversed Z: toward the eye is a positive offset. With a float depth buffer one
+    // unit is 2^-23 of the face's own largest depth, so the pull stays a few ulps of
+    // distance at 1e-3 and at 1e6 alike.
     glEnable(GL_POLYGON_OFFSET_FILL);
-    glPolygonOffset(-1.0f, -4.0f);
+    glPolygonOffset(detail::kTowardEye * 1.0f, detail::kTowardEye * 4.0f);
     glUseProgram(program_);
     glUniformMatrix4fv(locViewProj_, 1, GL_FALSE, glm::value_ptr(viewProj_));
     glBindVertexArray(boxVao_);

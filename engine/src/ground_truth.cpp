@@ -11,6 +11,7 @@
 
 #include "dyncull/engine/engine.hpp"
 #include "dyncull/engine/gl_context.hpp"
+#include "depth_convention.hpp"
 #include "shader_program.hpp"
 
 namespace dyncull {
@@ -36,32 +37,31 @@ layout(location = 0) out uint outId;
 void main() { outId = uId; }
 )";
 
-// Window depth ([0, 1], this pass's convention) of a camera-relative clip-space point.
-float windowDepth(const glm::vec4& clip) { return 0.5f * clip.z / clip.w + 0.5f; }
-
 }  // namespace
 
 glm::vec2 GroundTruth::windowDepthRange(const SceneObjects& objects, NodeRef ref, const Camera& camera,
-                                        const glm::mat4& viewProj) {
+                                        const glm::dmat4& viewProj) {
     const ModelId model = objects.modelOf(ref.object);
     const Aabb local = objects.model(model).nodes[ref.node].box;
     const glm::dmat4 m(objects.matrix(ref.object));
     const glm::dvec3 eye(camera.position);
-    float lo = 1.0f, hi = 0.0f;
+    double lo = 2.0, hi = -1.0;
     for (int c = 0; c < 8; ++c) {
         const glm::dvec3 p((c & 1) ? local.max.x : local.min.x, (c & 2) ? local.max.y : local.min.y,
                            (c & 4) ? local.max.z : local.min.z);
-        const glm::vec4 clip = viewProj * glm::vec4(glm::vec3(glm::dvec3(m * glm::dvec4(p, 1.0)) - eye), 1.0f);
-        // A corner at or behind the near plane: the clipped part may have any depth.
-        if (!(clip.w > 0.0f) || clip.z < -clip.w) return {-1.0f, 2.0f};
-        const float z = windowDepth(clip);
+        const glm::dvec4 clip = viewProj * glm::dvec4(glm::dvec3(m * glm::dvec4(p, 1.0)) - eye, 1.0);
+        // A corner at or behind the near plane (clip w is the view distance): the clipped
+        // part may have any depth.
+        if (!(clip.w > double(camera.nearPlane))) return {-1.0f, 2.0f};
+        const double z = clip.z / clip.w;  // window depth: reversed Z, GL_ZERO_TO_ONE, no remap
         lo = std::min(lo, z);
         hi = std::max(hi, z);
     }
-    // Slack far above float rounding of correct fragments (a few ulp, 6e-8 each near 1)
-    // and far below the artefacts seen (1e-2).
-    constexpr float kSlack = 0x1p-14f;
-    return {lo - kSlack, hi + kSlack};
+    // Slack far above float rounding of correct fragments (a few ulp of their triangle's
+    // largest depth, which is at most hi) and far below the artefacts seen (at about a
+    // third of their part's distance, i.e. 3x its depth).
+    const double slack = 0x1p-14 * hi;
+    return {static_cast<float>(lo - slack), static_cast<float>(hi + slack)};
 }
 
 std::uint32_t VisibleSet::pixelsOf(PartKey key) const {
@@ -148,12 +148,12 @@ VisibleSet GroundTruth::compute(const SceneObjects& objects, const Camera& camer
     glDepthMask(GL_TRUE);
     glDisable(GL_BLEND);
     glDisable(GL_CULL_FACE);  // as the renderer: both sides of every triangle
+    detail::useReversedDepth();
     glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
+    glDepthFunc(detail::kDepthNearer);
     const GLuint zero[4] = {0, 0, 0, 0};
     glClearBufferuiv(GL_COLOR, 0, zero);
-    const GLfloat one = 1.0f;
-    glClearBufferfv(GL_DEPTH, 0, &one);
+    glClearBufferfv(GL_DEPTH, 0, &detail::kDepthCleared);
     glUseProgram(program_);
     glUniformMatrix4fv(locViewProj_, 1, GL_FALSE, glm::value_ptr(viewProj));
     for (std::size_t i = 0; i < candidates_.size(); ++i) {
@@ -183,12 +183,14 @@ VisibleSet GroundTruth::compute(const SceneObjects& objects, const Camera& camer
     // Rasteriser depth artefacts. A correct fragment of a part lies in the window-depth
     // range of the part's box (the projection of a box in front of the eye is the hull of
     // its projected corners). llvmpipe occasionally writes a fragment of a tiny, nearly
-    // edge-on triangle far outside its triangle's depth range (measured: 0.9881 for a
-    // bunny part whose every vertex lies in [0.99611, 0.99639]); such a fragment is not a
-    // visible surface point, no query volume can be in front of it, and it is not counted.
+    // edge-on triangle far outside its triangle's depth range (measured under OpenGL's
+    // [-1, 1] depth: 0.9881 for a bunny part whose every vertex lies in [0.99611, 0.99639]);
+    // such a fragment is not a visible surface point, no query volume can be in front of
+    // it, and it is not counted.
+    const glm::dmat4 viewProjD = camera.viewProjectionRelativeDouble();
     depthRange_.resize(candidates_.size());
     for (std::size_t i = 0; i < candidates_.size(); ++i)
-        depthRange_[i] = windowDepthRange(objects, candidates_[i], camera, viewProj);
+        depthRange_[i] = windowDepthRange(objects, candidates_[i], camera, viewProjD);
     std::uint32_t artefacts = 0;
     for (std::size_t k = 0; k < bottomUp.size(); ++k) {
         const std::uint32_t id = bottomUp[k];

@@ -9,6 +9,7 @@
 #include <glm/gtc/matrix_inverse.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
+#include "depth_convention.hpp"
 #include "shader_program.hpp"
 
 namespace dyncull {
@@ -99,10 +100,11 @@ void Renderer::beginFrame(const Camera& camera) {
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glDepthMask(GL_TRUE);
     glClearColor(kClearColour.r, kClearColour.g, kClearColour.b, 1.0f);
-    glClearDepth(1.0);
+    detail::useReversedDepth();
+    glClearDepth(detail::kDepthCleared);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
+    glDepthFunc(detail::kDepthNearer);
     glDisable(GL_CULL_FACE);  // loaded meshes have unreliable winding; the shader lights both sides
 
     viewProj_ = camera.viewProjection();

@@ -9,13 +9,32 @@ namespace dyncull {
 
 glm::mat4 Camera::view() const { return glm::lookAt(position, target, up); }
 
-glm::mat4 Camera::projection() const { return glm::perspective(fovYRadians, aspect, nearPlane, farPlane); }
+glm::dmat4 reversedZPerspective(double fovY, double aspect, double n, double f) {
+    // Column-major. Double: at near 1e-4 and far 1e7 the terms n / (f - n) = 1e-11 and
+    // n f / (f - n) ~ n are each exact to float once rounded; nothing cancels (unlike
+    // OpenGL's (f + n) / (f - n), which is 1 in float).
+    const double t = std::tan(0.5 * fovY);
+    glm::dmat4 p(0.0);
+    p[0][0] = 1.0 / (aspect * t);
+    p[1][1] = 1.0 / t;
+    p[2][2] = n / (f - n);
+    p[2][3] = -1.0;  // clip w = -z_view = distance along the view direction
+    p[3][2] = n * f / (f - n);
+    return p;
+}
 
-glm::mat4 Camera::viewProjectionRelative() const {
+glm::dmat4 Camera::projectionDouble() const {
+    return reversedZPerspective(fovYRadians, aspect, nearPlane, farPlane);
+}
+
+glm::mat4 Camera::viewProjection() const {
+    return glm::mat4(projectionDouble() * glm::lookAt(glm::dvec3(position), glm::dvec3(target), glm::dvec3(up)));
+}
+
+glm::dmat4 Camera::viewProjectionRelativeDouble() const {
     const glm::dvec3 eye(position);
     const glm::dmat4 rot = glm::lookAt(glm::dvec3(0.0), glm::dvec3(target) - eye, glm::dvec3(up));
-    const glm::dmat4 proj = glm::perspective(double(fovYRadians), double(aspect), double(nearPlane), double(farPlane));
-    return glm::mat4(proj * rot);
+    return projectionDouble() * rot;
 }
 
 glm::mat4 Camera::relativeModel(const glm::mat4& objectToWorld) const {
@@ -59,23 +78,26 @@ Status validateCamera(const Camera& c) {
     return {};
 }
 
-Frustum Frustum::fromMatrix(const glm::mat4& m) {
-    // Gribb-Hartmann: planes are sums/differences of the rows of the clip matrix.
-    const glm::vec4 r0(m[0][0], m[1][0], m[2][0], m[3][0]);
-    const glm::vec4 r1(m[0][1], m[1][1], m[2][1], m[3][1]);
-    const glm::vec4 r2(m[0][2], m[1][2], m[2][2], m[3][2]);
-    const glm::vec4 r3(m[0][3], m[1][3], m[2][3], m[3][3]);
+Frustum Frustum::fromMatrix(const glm::mat4& m) { return fromMatrix(glm::dmat4(m)); }
+
+Frustum Frustum::fromMatrix(const glm::dmat4& m) {
+    // Gribb-Hartmann: planes are sums/differences of the rows of the clip matrix; reversed
+    // Z puts the near plane at z <= w and the far plane at z >= 0.
+    const glm::dvec4 r0(m[0][0], m[1][0], m[2][0], m[3][0]);
+    const glm::dvec4 r1(m[0][1], m[1][1], m[2][1], m[3][1]);
+    const glm::dvec4 r2(m[0][2], m[1][2], m[2][2], m[3][2]);
+    const glm::dvec4 r3(m[0][3], m[1][3], m[2][3], m[3][3]);
+    const glm::dvec4 planes[6] = {r3 + r0, r3 - r0, r3 + r1, r3 - r1, r3 - r2, r2};
     Frustum f;
-    f.planes = {r3 + r0, r3 - r0, r3 + r1, r3 - r1, r3 + r2, r3 - r2};
-    for (glm::vec4& p : f.planes) {
-        const float len = glm::length(glm::vec3(p));
-        if (len > 0.0f) p /= len;
+    for (int i = 0; i < 6; ++i) {
+        const double len = glm::length(glm::dvec3(planes[i]));
+        f.planes[static_cast<std::size_t>(i)] = glm::vec4(len > 0.0 ? planes[i] / len : planes[i]);
     }
     return f;
 }
 
 Frustum Frustum::fromCamera(const Camera& camera) {
-    Frustum f = fromMatrix(camera.viewProjectionRelative());
+    Frustum f = fromMatrix(camera.viewProjectionRelativeDouble());
     f.origin = glm::dvec3(camera.position);
     return f;
 }

@@ -73,7 +73,7 @@ FrameStats QueryScheduler::cullFrame(const TwoLevelTree& tree, const Camera& cam
     camera_ = camera;
     // Camera-relative (eye at the origin, set up in double): precise at any distance from
     // the world origin, like the renderer's and the query backend's transforms.
-    viewProj_ = camera.viewProjectionRelative();
+    viewProj_ = camera.viewProjectionRelativeDouble();
     frustum_ = Frustum::fromCamera(camera);
     width_ = width;
     height_ = height;
@@ -145,33 +145,47 @@ QueryResult QueryScheduler::timedPoll(QueryId id) {
 bool QueryScheduler::projectRect(const Aabb& box, ScreenRect& out) const {
     // Project the box clipped to the near plane, so boxes crossing it still get a correct
     // (conservative) rectangle. Returns false if the box crosses the near plane.
-    glm::vec4 clip[8];
-    bool front[8];
+    // Double and camera-relative: clip w is the view distance along the view direction,
+    // so the near test compares distances directly (no depth terms of the projection,
+    // which at near 1e-4 and far 1e7 span 11 orders of magnitude).
+    const glm::dvec3 eye(camera_.position);
+    const glm::dvec3 lo3 = glm::dvec3(box.min) - eye, hi3 = glm::dvec3(box.max) - eye;
+    // A box this close to the near plane counts as crossing it: the GPU clips a query
+    // volume with float vertices relative to the eye, which a backend may also push out by
+    // up to 2^-22 of its world coordinates (QueryBackend::issue).
+    // 2^-21 of the box's and 2^-22 of the eye-relative magnitude (and of near) cover both
+    // roundings with a factor of two to spare.
+    auto magnitude = [](const glm::dvec3& a, const glm::dvec3& b) {
+        const glm::dvec3 m = glm::max(glm::abs(a), glm::abs(b));
+        return std::max({m.x, m.y, m.z});
+    };
+    const double nearPlane = double(camera_.nearPlane);
+    const double nearTest = nearPlane + 0x1p-21 * magnitude(glm::dvec3(box.min), glm::dvec3(box.max)) +
+                            0x1p-22 * (magnitude(lo3, hi3) + nearPlane);
+    glm::dvec4 clip[8];
+    bool front[8];  // in front of the near plane itself: part of the rectangle
     bool crosses = false;
     for (int i = 0; i < 8; ++i) {
-        const glm::dvec3 c((i & 1) ? box.max.x : box.min.x, (i & 2) ? box.max.y : box.min.y,
-                           (i & 4) ? box.max.z : box.min.z);
-        clip[i] = viewProj_ * glm::vec4(glm::vec3(c - glm::dvec3(camera_.position)), 1.0f);
-        front[i] = clip[i].z >= -clip[i].w;  // in front of the near plane (GL clip space)
-        crosses |= !front[i];
+        const glm::dvec3 c((i & 1) ? hi3.x : lo3.x, (i & 2) ? hi3.y : lo3.y, (i & 4) ? hi3.z : lo3.z);
+        clip[i] = viewProj_ * glm::dvec4(c, 1.0);
+        front[i] = clip[i].w >= nearPlane;
+        crosses |= clip[i].w < nearTest;
     }
-    glm::vec2 lo(1e30f), hi(-1e30f);
-    auto addPoint = [&](const glm::vec4& p) {
-        // w > 0 for any point on or in front of the near plane (w = -z_view >= near > 0).
-        const glm::vec2 ndc = glm::vec2(p) / std::max(p.w, 1e-30f);
+    glm::dvec2 lo(1e300), hi(-1e300);
+    auto addPoint = [&](const glm::dvec4& p) {
+        const glm::dvec2 ndc = glm::dvec2(p) / p.w;  // w >= near > 0 for every point added
         lo = glm::min(lo, ndc);
         hi = glm::max(hi, ndc);
     };
     for (int i = 0; i < 8; ++i)
         if (front[i]) addPoint(clip[i]);
-    if (crosses) {
-        // The 12 edges: pairs of corners differing in exactly one bit.
+    {
+        // The 12 edges: pairs of corners differing in exactly one bit, cut at the near plane.
         for (int i = 0; i < 8; ++i)
             for (int bit = 1; bit < 8; bit <<= 1) {
                 const int j = i | bit;
                 if (j == i || front[i] == front[j]) continue;
-                const float di = clip[i].z + clip[i].w, dj = clip[j].z + clip[j].w;
-                const float t = di / (di - dj);
+                const double t = (clip[i].w - nearPlane) / (clip[i].w - clip[j].w);
                 addPoint(clip[i] + (clip[j] - clip[i]) * t);
             }
     }
@@ -181,12 +195,12 @@ bool QueryScheduler::projectRect(const Aabb& box, ScreenRect& out) const {
     }
     // Pixels, rounded outwards and padded by one so rasterisation rules never leave a
     // covered pixel outside the rectangle.
-    const float fx = 0.5f * static_cast<float>(width_), fy = 0.5f * static_cast<float>(height_);
-    auto clampi = [](float v, int lim) { return static_cast<int>(std::clamp(v, 0.0f, static_cast<float>(lim))); };
-    out.x0 = clampi(std::floor((lo.x + 1.0f) * fx) - 1.0f, width_);
-    out.y0 = clampi(std::floor((lo.y + 1.0f) * fy) - 1.0f, height_);
-    out.x1 = clampi(std::ceil((hi.x + 1.0f) * fx) + 1.0f, width_);
-    out.y1 = clampi(std::ceil((hi.y + 1.0f) * fy) + 1.0f, height_);
+    const double fx = 0.5 * width_, fy = 0.5 * height_;
+    auto clampi = [](double v, int lim) { return static_cast<int>(std::clamp(v, 0.0, static_cast<double>(lim))); };
+    out.x0 = clampi(std::floor((lo.x + 1.0) * fx) - 1.0, width_);
+    out.y0 = clampi(std::floor((lo.y + 1.0) * fy) - 1.0, height_);
+    out.x1 = clampi(std::ceil((hi.x + 1.0) * fx) + 1.0, width_);
+    out.y1 = clampi(std::ceil((hi.y + 1.0) * fy) + 1.0, height_);
     return !crosses;
 }
 

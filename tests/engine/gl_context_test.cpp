@@ -23,6 +23,7 @@ TEST(GlContext, HeadlessEglCreatesGl45CoreWithFbo) {
     EXPECT_GE(major * 10 + minor, 45);
     EXPECT_TRUE(profile & GL_CONTEXT_CORE_PROFILE_BIT);
     EXPECT_TRUE(ctx->isDebug());
+    test::expectReversedZFloatDepth(*ctx);
     std::printf("renderer: %s via %s, GL %s\n", ctx->rendererName().c_str(), ctx->platformName().c_str(),
                 ctx->versionString().c_str());
     EXPECT_EQ(ctx->checkErrors(), 0u);

@@ -1,6 +1,7 @@
 // Shared helpers for GL tests: a small headless context and a camera looking down -Z.
 #pragma once
 
+#include <epoxy/gl.h>
 #include <gtest/gtest.h>
 
 #include "dyncull/engine/gl_context.hpp"
@@ -31,6 +32,22 @@ inline Camera cameraOnZ(float dist = 3.0f) {
     c.nearPlane = 0.1f;
     c.farPlane = 100.0f;
     return c;
+}
+
+/// The context renders with the engine's depth convention (objects/camera.hpp): a 32-bit
+/// float depth attachment and clip z / w used as depth unchanged (GL_ZERO_TO_ONE).
+inline void expectReversedZFloatDepth(const GlContext& ctx) {
+    GLint type = 0, bits = 0, origin = 0, depthMode = 0;
+    glGetNamedFramebufferAttachmentParameteriv(ctx.framebuffer(), GL_DEPTH_ATTACHMENT,
+                                               GL_FRAMEBUFFER_ATTACHMENT_COMPONENT_TYPE, &type);
+    glGetNamedFramebufferAttachmentParameteriv(ctx.framebuffer(), GL_DEPTH_ATTACHMENT,
+                                               GL_FRAMEBUFFER_ATTACHMENT_DEPTH_SIZE, &bits);
+    glGetIntegerv(GL_CLIP_ORIGIN, &origin);
+    glGetIntegerv(GL_CLIP_DEPTH_MODE, &depthMode);
+    EXPECT_EQ(type, GL_FLOAT);
+    EXPECT_EQ(bits, 32);
+    EXPECT_EQ(origin, GL_LOWER_LEFT);
+    EXPECT_EQ(depthMode, GL_ZERO_TO_ONE);
 }
 
 inline bool isClear(glm::u8vec4 p) {

@@ -334,6 +334,65 @@ TEST(QueryScheduler, ParamsAreValidated) {
     EXPECT_EQ(parseCullMode("full").value(), CullMode::Full);
 }
 
+// Which of `cubes` (front-face distances from the eye along -Z, cube half size `half`)
+// full mode draws when every query answers "occluded": only boxes it must not query
+// (crossing the near plane, within rounding of it) get drawn.
+std::vector<bool> drawnWhenAllOccluded(const glm::vec3& eye, float nearPlane, float farPlane, float half,
+                                       const std::vector<double>& frontDistances, FrameStats& st) {
+    SceneObjects objects;
+    const ModelId cube = objects.addModel(cubeModel(half));
+    std::vector<ObjectHandle> hs;
+    for (std::size_t i = 0; i < frontDistances.size(); ++i) {
+        Transform t;  // side by side, all inside the view
+        t.translation = glm::vec3(glm::dvec3(eye) + glm::dvec3((double(i) - 0.5 * double(frontDistances.size() - 1)) * 3.0 * half, 0.0,
+                                                               -(frontDistances[i] + half)));
+        hs.push_back(objects.addObject(cube, t).take());
+    }
+    LooseBsp bsp;
+    bsp.build(objects);
+    Camera c;
+    c.position = eye;
+    c.target = eye + glm::vec3(0, 0, -1);
+    c.nearPlane = nearPlane;
+    c.farPlane = farPlane;
+    c.aspect = 2.0f;
+    ScriptedBackend b;
+    b.rule = [](const QueryVolume&) { return QueryResult::Occluded; };
+    SchedulerParams p;
+    p.useOccupancyAccept = false;
+    QueryScheduler sched(p);
+    RecordingSink sink;
+    TwoLevelTree tree(bsp, objects);
+    st = sched.cullFrame(tree, c, 640, 320, b, sink);
+    std::vector<bool> drawn;
+    for (const ObjectHandle& h : hs) drawn.push_back(sink.drawn.count(h.index) > 0);
+    return drawn;
+}
+
+TEST(QueryScheduler, NearPlaneTestHoldsAtNear1eMinus4AndFar1e7) {
+    // Cubes of half size 1e-5 whose front faces are 1e-6 of the near distance behind the
+    // near plane (crossing it by 1e-10 units: drawn without a query) and 1e-3 in front
+    // (queried, answered occluded, not drawn).
+    const double n = 1e-4;
+    FrameStats st;
+    const auto drawn = drawnWhenAllOccluded({0, 0, 0}, float(n), 1e7f, 1e-5f, {n * (1.0 - 1e-6), n * (1.0 + 1e-3)}, st);
+    EXPECT_TRUE(drawn[0]);
+    EXPECT_FALSE(drawn[1]);
+    EXPECT_GE(st.visibleNearOrInside, 1u);
+    EXPECT_GE(st.queriesOccluded, 1u);
+}
+
+TEST(QueryScheduler, BoxesWithinWorldRoundingOfTheNearPlaneAreNotQueried) {
+    // Eye 1e6 units from the origin, where world coordinates round to 2^-4 units and query
+    // volumes may be padded by 2^-22 of them (0.24 units): a cube 0.2 in front of the eye
+    // is drawn without a query (its volume could reach the near plane), one 20 in front is
+    // queried (occluded, not drawn).
+    FrameStats st;
+    const auto drawn = drawnWhenAllOccluded({1e6f, 0, 0}, 0.01f, 1e4f, 0.05f, {0.2, 20.0}, st);
+    EXPECT_TRUE(drawn[0]);
+    EXPECT_FALSE(drawn[1]);
+}
+
 TEST(QueryScheduler, FrontMostLeavesAreDrawnWithoutQueries) {
     // k-DOP paper, section 4: the first frontPercent of the frustum leaves in front-to-back
     // order are drawn untested. Every query answers "occluded", so what is drawn is exactly

@@ -41,7 +41,8 @@ public:
 
     /// Draws and clears the queue into the currently bound framebuffer with its current
     /// viewport (`viewportPixels` = its size, for the line width). Lines are `widthPixels`
-    /// wide, alpha-blended. Leaves the renderer's defaults behind: depth test on with GL_LESS,
+    /// wide, alpha-blended. `viewProjection` is world to clip in Camera's reversed-Z
+    /// convention. Leaves the renderer's defaults behind: depth test on with GL_GREATER,
     /// depth writes on, blending off (program and VAO bindings are left changed).
     void flush(const glm::mat4& viewProjection, glm::ivec2 viewportPixels, LineDepth depth = LineDepth::XRay,
                float widthPixels = 2.0f, float hiddenAlpha = 0.3f);

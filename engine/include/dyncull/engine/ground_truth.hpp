@@ -1,7 +1,8 @@
 // Exact visibility of object parts for measuring culling modes: an ID pass draws every
 // local-BSP leaf of every live object that is not outside the frustum (no occlusion
 // culling) with its part id into an integer target, depth-tested exactly like the
-// renderer (same positions, matrices, GL_LESS, 32-bit float depth), and reads it back.
+// renderer (same positions, matrices, reversed Z with GL_GREATER, 32-bit float depth),
+// and reads it back.
 // A part is visible iff it owns at least one pixel; its pixel count comes with it.
 #pragma once
 
@@ -72,10 +73,11 @@ public:
 private:
     explicit GroundTruth(GlContext& context) : context_(context) {}
     void uploadModels(const SceneObjects& objects);
-    /// Window-depth interval (with rounding slack) that every correct fragment of leaf
-    /// `ref` lies in; [-1, 2] (no constraint) if its box reaches the near plane.
+    /// Window-depth interval (reversed Z; with rounding slack) that every correct fragment
+    /// of leaf `ref` lies in; [-1, 2] (no constraint) if its box reaches the near plane.
+    /// `viewProj`: camera.viewProjectionRelativeDouble().
     static glm::vec2 windowDepthRange(const SceneObjects& objects, NodeRef ref, const Camera& camera,
-                                      const glm::mat4& viewProj);
+                                      const glm::dmat4& viewProj);
 
     struct GpuModel {
         std::uint32_t vao = 0, vbo = 0, ibo = 0;

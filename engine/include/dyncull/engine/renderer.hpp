@@ -51,7 +51,8 @@ public:
     std::size_t uploadedBytes() const { return uploadedBytes_; }
 
     /// Binds the context framebuffer, sets the viewport to its full size, clears colour
-    /// and depth, and takes view/projection from `camera` (world space). The camera's
+    /// and depth (to 0: reversed Z, nearer fragments win with GL_GREATER; see
+    /// objects/camera.hpp), and takes view/projection from `camera` (world space). The camera's
     /// aspect is used as given (set it to width/height of the context).
     void beginFrame(const Camera& camera);
     /// Draws indices [firstIndex, firstIndex + indexCount) of mesh `id` with object-to-world

@@ -62,6 +62,10 @@ public:
     /// Brackets a group of queries issued together, so state (colour/depth masks,
     /// the volume shader) is switched once per batch rather than once per query.
     virtual void beginBatch() = 0;
+    /// Draws `volume` depth-tested against what is drawn so far. A backend may draw it
+    /// enlarged by up to 2^-22 of its largest world coordinate per axis (GlQueryBackend
+    /// does, to cover float rounding far from the origin); the scheduler never queries a box
+    /// that could then reach the near plane (QueryScheduler::projectRect).
     virtual QueryId issue(const QueryVolume& volume) = 0;
     virtual void endBatch() = 0;
     /// Non-blocking.

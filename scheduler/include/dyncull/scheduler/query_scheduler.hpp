@@ -162,7 +162,7 @@ private:
     QueryBackend* backend_ = nullptr;
     PartSink* sink_ = nullptr;
     Camera camera_;
-    glm::mat4 viewProj_{1.0f};  // camera-relative (Camera::viewProjectionRelative)
+    glm::dmat4 viewProj_{1.0};  // camera-relative (Camera::viewProjectionRelativeDouble)
     Frustum frustum_;
     int width_ = 0, height_ = 0;
     FrameStats* stats_ = nullptr;
