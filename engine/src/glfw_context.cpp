@@ -1,5 +1,8 @@
 // OpenGL 4.5 core context in a GLFW window (needs an X display, e.g. Xvfb). Renders into
-// the window's default framebuffer; present() swaps and polls events.
+// an offscreen FBO with a 32-bit float depth buffer, like the headless context: reversed Z
+// (objects/camera.hpp) needs float depth, and a window's default depth buffer is 24-bit
+// fixed point. present() copies the colour to the window, swaps and polls events.
+#include <algorithm>
 #include <string>
 
 #include <epoxy/gl.h>  // before GLFW so GLFW does not pull in the system GL header
@@ -31,22 +34,48 @@ class GlfwContext final : public GlContext {
 public:
     GlfwContext() : GlContext(ContextKind::GlfwWindow) {}
     ~GlfwContext() override {
-        if (window_) glfwDestroyWindow(window_);
+        if (window_) {
+            glfwMakeContextCurrent(window_);
+            if (framebuffer_) glDeleteFramebuffers(1, &framebuffer_);
+            if (colour_) glDeleteRenderbuffers(1, &colour_);
+            if (depth_) glDeleteRenderbuffers(1, &depth_);
+            glfwDestroyWindow(window_);
+        }
         if (--liveWindows() == 0) glfwTerminate();
     }
     void makeCurrent() override { glfwMakeContextCurrent(window_); }
     void present() override {
+        glBlitNamedFramebuffer(framebuffer_, 0, 0, 0, size_.x, size_.y, 0, 0, size_.x, size_.y, GL_COLOR_BUFFER_BIT,
+                               GL_NEAREST);
         glfwSwapBuffers(window_);
         glfwPollEvents();
         int w = 0, h = 0;
         glfwGetFramebufferSize(window_, &w, &h);
-        if (w > 0 && h > 0) size_ = {w, h};  // follow user resizes; 0x0 while minimised
+        // Follow user resizes (0x0 while minimised: keep the last size).
+        if (w > 0 && h > 0 && glm::ivec2(w, h) != size_) resizeFramebuffer(w, h);
+    }
+    /// Creates the FBO on first use; later calls re-specify its attachments' storage.
+    std::string resizeFramebuffer(int w, int h) {
+        if (!framebuffer_) {
+            glCreateRenderbuffers(1, &colour_);
+            glCreateRenderbuffers(1, &depth_);
+            glCreateFramebuffers(1, &framebuffer_);
+        }
+        glNamedRenderbufferStorage(colour_, GL_RGBA8, w, h);
+        glNamedRenderbufferStorage(depth_, GL_DEPTH_COMPONENT32F, w, h);
+        glNamedFramebufferRenderbuffer(framebuffer_, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, colour_);
+        glNamedFramebufferRenderbuffer(framebuffer_, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_);
+        const GLenum status = glCheckNamedFramebufferStatus(framebuffer_, GL_FRAMEBUFFER);
+        if (status != GL_FRAMEBUFFER_COMPLETE) return "window framebuffer incomplete (status " + std::to_string(status) + ")";
+        size_ = {w, h};
+        return {};
     }
     bool shouldClose() const override { return glfwWindowShouldClose(window_) != 0; }
     InputFrame takeInput() override { return input_.take(); }
     void setCursorCaptured(bool captured) override { input_.setCursorCaptured(captured); }
 
     GLFWwindow* window_ = nullptr;
+    GLuint colour_ = 0, depth_ = 0;
     detail::GlfwInputCollector input_;
 };
 
@@ -66,7 +95,7 @@ Expected<std::unique_ptr<GlContext>> createGlfwContext(const ContextOptions& o) 
     glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
     glfwWindowHint(GLFW_OPENGL_DEBUG_CONTEXT, o.debug ? GLFW_TRUE : GLFW_FALSE);
     glfwWindowHint(GLFW_VISIBLE, o.visible ? GLFW_TRUE : GLFW_FALSE);
-    glfwWindowHint(GLFW_DEPTH_BITS, 24);
+    glfwWindowHint(GLFW_DEPTH_BITS, 0);  // depth lives in the offscreen FBO
     // Robust context with reset notification where the driver offers it (see
     // GlContext::resetNotification); otherwise the same window without.
     glfwWindowHint(GLFW_CONTEXT_ROBUSTNESS, GLFW_LOSE_CONTEXT_ON_RESET);
@@ -84,12 +113,12 @@ Expected<std::unique_ptr<GlContext>> createGlfwContext(const ContextOptions& o) 
     glfwSwapInterval(0);  // measurements must not be paced by vsync
     int w = 0, h = 0;
     glfwGetFramebufferSize(ctx->window_, &w, &h);
-    ctx->size_ = {w, h};
-    ctx->framebuffer_ = 0;
     int vmaj = 0, vmin = 0, vrev = 0;
     glfwGetVersion(&vmaj, &vmin, &vrev);
     ctx->platform_ = "GLFW " + std::to_string(vmaj) + "." + std::to_string(vmin) + "." + std::to_string(vrev) + " window";
     ctx->initCommon(o.debug);
+    if (std::string e = ctx->resizeFramebuffer(std::max(w, 1), std::max(h, 1)); !e.empty()) return Error{"GLFW: " + e};
+    glBindFramebuffer(GL_FRAMEBUFFER, ctx->framebuffer_);
     return std::unique_ptr<GlContext>(std::move(ctx));
 }
 

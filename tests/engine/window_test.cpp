@@ -4,12 +4,13 @@
 #include <gtest/gtest.h>
 
 #include "dyncull/engine/renderer.hpp"
+#include "gl_test_util.hpp"
 #include "procedural_meshes.hpp"
 
 namespace dyncull {
 namespace {
 
-TEST(Window, RendersIntoDefaultFramebuffer) {
+TEST(Window, RendersIntoAFloatDepthFramebufferAndPresents) {
     if (!std::getenv("DISPLAY")) GTEST_SKIP() << "no X display (DISPLAY unset)";
     ContextOptions o;
     o.kind = ContextKind::GlfwWindow;
@@ -20,7 +21,8 @@ TEST(Window, RendersIntoDefaultFramebuffer) {
     auto ctx = GlContext::create(o);
     ASSERT_TRUE(ctx.ok()) << ctx.error().message;
     EXPECT_EQ((*ctx)->kind(), ContextKind::GlfwWindow);
-    EXPECT_EQ((*ctx)->framebuffer(), 0u);
+    EXPECT_NE((*ctx)->framebuffer(), 0u);  // offscreen, float depth: reversed Z
+    test::expectReversedZFloatDepth(**ctx);
     EXPECT_EQ((*ctx)->size(), glm::ivec2(64, 48));
     auto r = Renderer::create(**ctx);
     ASSERT_TRUE(r.ok()) << r.error().message;

@@ -1,6 +1,7 @@
-// An OpenGL 4.5 core context to render into: headless EGL (default, renders into an
-// offscreen FBO) or a GLFW window (renders into the window's back buffer). The renderer
-// only sees framebuffer() and size(), so one code path serves both.
+// An OpenGL 4.5 core context to render into: headless EGL (default) or a GLFW window. Both
+// render into an offscreen FBO with RGBA8 colour and 32-bit float depth (reversed Z needs
+// float depth; objects/camera.hpp); a window's present() copies the colour to the window.
+// The renderer only sees framebuffer() and size(), so one code path serves both.
 #pragma once
 
 #include <cstdint>
@@ -60,7 +61,8 @@ public:
     GlContext& operator=(const GlContext&) = delete;
 
     virtual void makeCurrent() = 0;
-    /// Windows: swap buffers and poll events. Headless: glFlush.
+    /// Windows: copy the FBO's colour to the window, swap buffers, poll events, and follow
+    /// a resize (size() and the FBO change with the window). Headless: glFlush.
     virtual void present() = 0;
     /// Windows: the user asked to close. Headless: always false.
     virtual bool shouldClose() const { return false; }
@@ -72,7 +74,7 @@ public:
     virtual void setCursorCaptured(bool /*captured*/) {}
 
     ContextKind kind() const { return kind_; }
-    /// GL name of the framebuffer to render into (0 = the window's default framebuffer).
+    /// GL name of the framebuffer to render into (an FBO with float depth; both kinds).
     std::uint32_t framebuffer() const { return framebuffer_; }
     /// Framebuffer size in pixels (may differ from the window size on HiDPI screens).
     glm::ivec2 size() const { return size_; }
@@ -125,7 +127,8 @@ protected:
 
 /// Headless EGL context with an RGBA8 + depth32F FBO of the requested size.
 Expected<std::unique_ptr<GlContext>> createEglContext(const ContextOptions& options);
-/// GLFW window context; fails cleanly when there is no display.
+/// GLFW window context with an RGBA8 + depth32F FBO of the window's framebuffer size;
+/// fails cleanly when there is no display.
 Expected<std::unique_ptr<GlContext>> createGlfwContext(const ContextOptions& options);
 
 }  // namespace dyncull
