@@ -1,0 +1,116 @@
+// Shared rig of the numerical-extremes tests: an engine with a vfc and a conservative full
+// scheduler, the ID-pass ground truth and a drawn-part recorder, rendering one frame with
+// each scheduler and comparing images and parts.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <string>
+
+#include "dyncull/engine/engine.hpp"
+#include "dyncull/engine/ground_truth.hpp"
+#include "dyncull/engine/image_compare.hpp"
+#include "engine/gl_test_util.hpp"
+
+namespace dyncull::test {
+
+inline constexpr int kWidth = 160, kHeight = 120;
+
+/// An engine with a vfc and a full scheduler, the ground truth, and a drawn-part recorder.
+struct Rig {
+    std::unique_ptr<GlContext> ctx;
+    std::unique_ptr<Engine> engine;
+    std::unique_ptr<GroundTruth> truth;
+    QueryScheduler vfc{[] {
+        SchedulerParams p;
+        p.mode = CullMode::Vfc;
+        return p;
+    }()};
+    QueryScheduler full{[] {
+        SchedulerParams p;
+        p.queryTimeoutMs = 20000.0;  // culling is checked here, not latency
+        return p;
+    }()};
+    DrawnPartRecorder recorder;
+
+    Rig() {
+        ctx = headless(kWidth, kHeight);
+        if (!ctx) return;
+        auto e = Engine::create(*ctx);
+        EXPECT_TRUE(e.ok()) << e.error().message;
+        engine = e.take();
+        auto t = GroundTruth::create(*ctx);
+        EXPECT_TRUE(t.ok());
+        truth = t.take();
+        engine->setPartObserver([this](std::uint32_t o, std::uint32_t first, std::uint32_t count) {
+            recorder.record(engine->objects(), o, first, count);
+        });
+    }
+    bool ok() const { return engine && truth; }
+    ModelId model(const Mesh& m, const LocalBspParams& params = {}) {
+        auto id = engine->addModel(m, params);
+        EXPECT_TRUE(id.ok()) << id.error().message;
+        return id.ok() ? *id : 0;
+    }
+    ObjectHandle object(ModelId m, const glm::vec3& at, const glm::vec3& scale = glm::vec3(1.0f)) {
+        Transform t;
+        t.translation = at;
+        t.scale = scale;
+        auto h = engine->addObject(m, t);
+        EXPECT_TRUE(h.ok()) << h.error().message;
+        return h.ok() ? *h : ObjectHandle{};
+    }
+
+    struct Result {
+        Image vfcImage, fullImage;
+        ImageDiff diff;
+        PartErrors errors;
+        FrameStats vfcStats, fullStats;
+        std::uint32_t visibleParts = 0;
+    };
+    /// One frame with each scheduler from `camera`.
+    Result frame(const Camera& camera) {
+        Result r;
+        EXPECT_TRUE(engine->setCamera(camera).ok());
+        r.vfcStats = *engine->renderFrame(vfc);
+        r.vfcImage = engine->renderer().readPixels();
+        recorder.clear();
+        r.fullStats = *engine->renderFrame(full);
+        r.fullImage = engine->renderer().readPixels();
+        auto d = compareImages(r.vfcImage, r.fullImage);
+        EXPECT_TRUE(d.ok());
+        r.diff = *d;
+        const VisibleSet vis = truth->compute(*engine, camera);
+        r.visibleParts = static_cast<std::uint32_t>(vis.parts.size());
+        r.errors = compareParts(vis, recorder.drawn());
+        EXPECT_EQ(ctx->checkErrors(), 0u);
+        return r;
+    }
+};
+
+inline Camera look(const glm::vec3& from, const glm::vec3& at, float nearPlane = 0.05f, float farPlane = 1000.0f) {
+    Camera c;
+    c.position = from;
+    c.target = at;
+    c.aspect = static_cast<float>(kWidth) / static_cast<float>(kHeight);
+    c.nearPlane = nearPlane;
+    c.farPlane = farPlane;
+    return c;
+}
+
+/// Full mode must be exact against vfc and the ground truth.
+inline void expectConservative(const Rig::Result& r, const std::string& what) {
+    EXPECT_LE(r.diff.percentDiffering, 0.01) << what;
+    EXPECT_EQ(r.errors.falseNegatives, 0u) << what;
+    EXPECT_EQ(r.fullStats.queriesTimedOut, 0u) << what;
+}
+
+inline std::uint64_t nonBackground(const Image& img) {
+    std::uint64_t n = 0;
+    for (std::size_t i = 0; i < img.rgba.size(); i += 4)
+        if (!isClear({img.rgba[i], img.rgba[i + 1], img.rgba[i + 2], img.rgba[i + 3]})) ++n;
+    return n;
+}
+
+}  // namespace dyncull::test
