@@ -483,7 +483,7 @@ void QueryScheduler::runFull() {
         deferred.insert(at, w);
         waitingMap_.mark(rect);
     };
-    const bool keepOrder = !params_.batchOverlapping;
+    const bool keepOrder = params_.useWaitOrder && !params_.batchOverlapping;
     // Occupancy-map fast accept: a rectangle touching screen area where nothing has been
     // drawn cannot be hidden. Tested as soon as a node is reached, even if a nearer waiting
     // node overlaps it: deferring the test too was measured slower (three times the

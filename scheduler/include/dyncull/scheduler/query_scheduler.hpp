@@ -36,6 +36,11 @@ struct SchedulerParams {
     bool useBatching = true;
     bool useOccupancyAccept = true;
     bool useTightVolumes = true;
+    /// A node waiting for a query (its rectangle overlaps a pending one) also holds back
+    /// every farther node whose rectangle overlaps it, so no node is queried before a
+    /// nearer waiting node in front of it is resolved. Off: only pending queries hold
+    /// nodes back (ablation).
+    bool useWaitOrder = true;
 
     HistoryParams history;
     std::uint32_t maxQueriesInFlight = 64;
