@@ -463,10 +463,10 @@ void QueryScheduler::runFull() {
         return true;
     };
 
-    // Nodes waiting for a query, nearest first. A waiting node blocks every farther node
-    // whose rectangle overlaps it (waitingMap_), not only pending queries do: otherwise a
-    // farther node would be queried before a nearer occluder in front of it is drawn, and
-    // drawn for nothing.
+    // Nodes waiting for a query, nearest first. With useWaitOrder a waiting node also
+    // blocks every farther node whose rectangle overlaps it (waitingMap_), so no node is
+    // queried before a nearer occluder in front of it is drawn (fewer parts drawn for
+    // nothing, more waiting).
     struct Deferred {
         float dist2;  // squared distance from the eye to the box centre
         NodeRef ref;

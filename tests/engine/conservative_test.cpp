@@ -77,7 +77,7 @@ TEST(Conservative, EveryConservativeModeDrawsTheVfcImage) {
     auto scene = makeBunnySwarm(bo);
     ASSERT_TRUE(scene->populate(engine).ok());
 
-    const char* conservative = "vfc,simple,full,full-nohist,full-nobatch,full-noocc,full-notight,full-noorder,front10,oracle,thr64";
+    const char* conservative = "vfc,simple,full,full-nohist,full-nobatch,full-noocc,full-notight,order,front10,oracle,thr64";
     auto modes = cli::modesFromList(conservative);
     ASSERT_TRUE(modes.ok()) << modes.error().message;
     // The test checks culling, not latency: a query that outlasts the default 250 ms bound

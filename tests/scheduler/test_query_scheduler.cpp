@@ -285,7 +285,7 @@ TEST(QueryScheduler, BatchesHoldOnlyNonOverlappingRectangles) {
     EXPECT_GT(multi, 0) << "expected some batches with several queries";
 }
 
-TEST(QueryScheduler, AFartherNodeNeverOvertakesAWaitingNearerNodeItOverlaps) {
+TEST(QueryScheduler, WithWaitOrderAFartherNodeNeverOvertakesAWaitingNearerNodeItOverlaps) {
     // Three cubes seen from the origin: P nearest; A behind, overlapping P on screen (so A
     // waits for P's query); F farthest, overlapping A but not P. F must wait for A too:
     // queried before A's answer, F would be tested against a depth buffer still missing A.
@@ -304,6 +304,7 @@ TEST(QueryScheduler, AFartherNodeNeverOvertakesAWaitingNearerNodeItOverlaps) {
     SchedulerParams p;
     p.useOccupancyAccept = false;  // an empty screen would accept everything
     p.occupancyTileSize = 8;
+    p.useWaitOrder = true;
     QueryScheduler sched(p);
     RecordingSink sink;
     TwoLevelTree tree(bsp, objects);
