@@ -38,9 +38,9 @@ struct SchedulerParams {
     bool useTightVolumes = true;
     /// A node waiting for a query (its rectangle overlaps a pending one) also holds back
     /// every farther node whose rectangle overlaps it, so no node is queried before a
-    /// nearer waiting node in front of it is resolved. Draws 10-14% fewer triangles on the
-    /// bunny swarm but waits twice as long: measured 3-30% slower on llvmpipe (see
-    /// docs/BENCHMARKS.md), hence off; a GPU, where overdraw costs more than a stall, may differ.
+    /// nearer waiting node in front of it is resolved. Draws 3-12% fewer triangles but
+    /// waits 1.4-4x as long: from as fast to 23% slower on llvmpipe (docs/BENCHMARKS.md),
+    /// hence off; a GPU, where overdraw costs more than a stall, may differ.
     bool useWaitOrder = false;
 
     HistoryParams history;
