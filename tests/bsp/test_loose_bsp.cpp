@@ -6,17 +6,13 @@
 #include "bsp_test_models.hpp"
 #include "dyncull/bsp/loose_bsp.hpp"
 #include "dyncull/objects/motion.hpp"
+#include "objects/transform_at.hpp"
 
 using namespace dyncull;
 
 namespace {
 
-Transform at(glm::vec3 p, float s = 1.0f) {
-    Transform t;
-    t.translation = p;
-    t.scale = glm::vec3(s);
-    return t;
-}
+using test::at;
 
 std::uint32_t maxObjectsInNode(const LooseBsp& bsp) {
     std::uint32_t m = 0;

@@ -5,17 +5,13 @@
 
 #include "bsp_test_models.hpp"
 #include "dyncull/bsp/scene_objects.hpp"
+#include "objects/transform_at.hpp"
 
 using namespace dyncull;
 
 namespace {
 
-Transform at(glm::vec3 p, float s = 1.0f) {
-    Transform t;
-    t.translation = p;
-    t.scale = glm::vec3(s);
-    return t;
-}
+using test::at;
 
 }  // namespace
 

@@ -6,18 +6,13 @@
 
 #include "bsp_test_models.hpp"
 #include "dyncull/bsp/traversal.hpp"
+#include "objects/transform_at.hpp"
 
 using namespace dyncull;
 
 namespace {
 
-Transform at(glm::vec3 p, float s = 1.0f, glm::quat r = glm::quat(1, 0, 0, 0)) {
-    Transform t;
-    t.translation = p;
-    t.scale = glm::vec3(s);
-    t.rotation = r;
-    return t;
-}
+using test::at;
 
 bool refLess(const NodeRef& a, const NodeRef& b) {
     return a.object != b.object ? a.object < b.object : a.node < b.node;

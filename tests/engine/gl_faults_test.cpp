@@ -11,6 +11,7 @@
 #include "dyncull/engine/engine.hpp"
 #include "engine/gl_test_util.hpp"
 #include "engine/procedural_meshes.hpp"
+#include "objects/transform_at.hpp"
 
 namespace dyncull {
 namespace {
@@ -19,11 +20,7 @@ using test::cameraOnZ;
 using test::headless;
 using test::isClear;
 
-Transform at(const glm::vec3& p) {
-    Transform t;
-    t.translation = p;
-    return t;
-}
+using test::at;
 
 bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 

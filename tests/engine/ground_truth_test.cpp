@@ -7,6 +7,7 @@
 #include "dyncull/engine/ground_truth.hpp"
 #include "engine/gl_test_util.hpp"
 #include "engine/procedural_meshes.hpp"
+#include "objects/transform_at.hpp"
 
 namespace dyncull {
 namespace {
@@ -15,11 +16,7 @@ using test::cameraOnZ;
 using test::headless;
 using test::isClear;
 
-Transform at(const glm::vec3& p) {
-    Transform t;
-    t.translation = p;
-    return t;
-}
+using test::at;
 
 struct QuadAndCube : ::testing::Test {
     std::unique_ptr<GlContext> ctx = headless();
