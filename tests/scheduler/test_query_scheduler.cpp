@@ -123,15 +123,21 @@ std::multiset<std::uint32_t> drawnWith(TestScene& s, SchedulerParams p, Scripted
     return sink.drawn;
 }
 
+/// What frustum culling alone draws: the reference every conservative mode must match.
+std::multiset<std::uint32_t> vfcDrawn(TestScene& s) {
+    ScriptedBackend backend;
+    SchedulerParams vfc;
+    vfc.mode = CullMode::Vfc;
+    auto drawn = drawnWith(s, vfc, backend);
+    EXPECT_EQ(backend.issued, 0);  // vfc never queries
+    return drawn;
+}
+
 }  // namespace
 
 TEST(QueryScheduler, AllVisibleDrawsExactlyWhatVfcDraws) {
     TestScene s(6, 5);
-    ScriptedBackend vfcBackend;
-    SchedulerParams vfc;
-    vfc.mode = CullMode::Vfc;
-    const auto reference = drawnWith(s, vfc, vfcBackend);
-    EXPECT_EQ(vfcBackend.issued, 0);
+    const auto reference = vfcDrawn(s);
     EXPECT_FALSE(reference.empty());
 
     for (CullMode mode : {CullMode::Simple, CullMode::Full}) {
@@ -153,10 +159,7 @@ TEST(QueryScheduler, AllVisibleDrawsExactlyWhatVfcDraws) {
 
 TEST(QueryScheduler, QueriesThatNeverAnswerCountAsVisibleAndTheFrameEnds) {
     TestScene s(4, 4);
-    ScriptedBackend vfcBackend;
-    SchedulerParams vfc;
-    vfc.mode = CullMode::Vfc;
-    const auto reference = drawnWith(s, vfc, vfcBackend);
+    const auto reference = vfcDrawn(s);
     ScriptedBackend b;
     b.neverAnswer = true;
     SchedulerParams p;
@@ -399,10 +402,7 @@ TEST(QueryScheduler, FrontMostLeavesAreDrawnWithoutQueries) {
     // order are drawn untested. Every query answers "occluded", so what is drawn is exactly
     // the front budget; at 100% everything in the frustum is drawn with no query at all.
     TestScene s(6, 5);
-    ScriptedBackend vfcBackend;
-    SchedulerParams vfc;
-    vfc.mode = CullMode::Vfc;
-    const auto reference = drawnWith(s, vfc, vfcBackend);
+    const auto reference = vfcDrawn(s);
     ASSERT_EQ(reference.size(), 30u);
     std::uint32_t nearest = 0;
     float nearestDist = 1e30f;
@@ -575,10 +575,7 @@ struct HungBackend final : QueryBackend {
 TEST(QueryFaults, HungQueriesInTheWaitPathCountVisibleWithinTheBound) {
     // Simple OC: every query goes through wait().
     TestScene s(4, 3);
-    ScriptedBackend vfcBackend;
-    SchedulerParams vfc;
-    vfc.mode = CullMode::Vfc;
-    const auto reference = drawnWith(s, vfc, vfcBackend);
+    const auto reference = vfcDrawn(s);
     HungBackend b;
     SchedulerParams p;
     p.mode = CullMode::Simple;
@@ -604,10 +601,7 @@ TEST(QueryFaults, HungQueriesInTheNonBlockingPathCountVisibleWithinTheBound) {
     // Full mode polls first and only waits when nothing else is left; with a small
     // in-flight limit it must go through both paths many times.
     TestScene s(5, 4);
-    ScriptedBackend vfcBackend;
-    SchedulerParams vfc;
-    vfc.mode = CullMode::Vfc;
-    const auto reference = drawnWith(s, vfc, vfcBackend);
+    const auto reference = vfcDrawn(s);
     HungBackend b;
     SchedulerParams p;
     p.mode = CullMode::Full;
@@ -636,10 +630,7 @@ TEST(QueryFaults, HungQueriesWithLastFrameResultsNeverCullAndNeverPileUp) {
     // The approximate one-frame-latency setting never waits: unanswered queries stay
     // in flight, the node stays visible, and no second query is stacked on it.
     TestScene s(4, 3);
-    ScriptedBackend vfcBackend;
-    SchedulerParams vfc;
-    vfc.mode = CullMode::Vfc;
-    const auto reference = drawnWith(s, vfc, vfcBackend);
+    const auto reference = vfcDrawn(s);
     HungBackend b;
     SchedulerParams p;
     p.useOccupancyAccept = false;
