@@ -57,25 +57,42 @@ void writeBlobPly(const fs::path& path, int rings, int segments) {
         }
 }
 
-TEST(Conservative, EveryConservativeModeDrawsTheVfcImage) {
-    const fs::path dir = fs::temp_directory_path() / ("dyncull_conservative_" + std::to_string(::getpid()));
-    fs::create_directories(dir);
-    const fs::path ply = dir / "blob.ply";
-    writeBlobPly(ply, 48, 96);  // 9,216 triangles: local BSP splits it into a few parts
+/// The moving swarm both image tests fly through: 40 blobs (the PLY above, 9,216
+/// triangles, which the local BSP splits into a few parts) in a box of 5, at 320x180.
+/// The blob file lives in a per-process temporary directory removed after the test.
+class ConservativeSwarm : public ::testing::Test {
+protected:
+    void build(const std::string& dirPrefix, std::uint64_t frames) {
+        dir = fs::temp_directory_path() / (dirPrefix + std::to_string(::getpid()));
+        fs::create_directories(dir);
+        const fs::path ply = dir / "blob.ply";
+        writeBlobPly(ply, 48, 96);
+        ctx = test::headless(320, 180);
+        ASSERT_TRUE(ctx);
+        auto engineOr = Engine::create(*ctx);
+        ASSERT_TRUE(engineOr.ok());
+        engine = engineOr.take();
+        bo.count = 40;
+        bo.box = 5.0f;
+        bo.speed = 0.05f;
+        bo.frames = frames;
+        bo.meshPath = ply.string();
+        scene = makeBunnySwarm(bo);
+        ASSERT_TRUE(scene->populate(*engine).ok());
+    }
+    void TearDown() override {
+        if (!dir.empty()) fs::remove_all(dir);
+    }
 
-    auto ctx = test::headless(320, 180);
-    ASSERT_TRUE(ctx);
-    auto engineOr = Engine::create(*ctx);
-    ASSERT_TRUE(engineOr.ok());
-    Engine& engine = **engineOr;
+    fs::path dir;
+    std::unique_ptr<GlContext> ctx;
+    std::unique_ptr<Engine> engine;
     BunnySwarmOptions bo;
-    bo.count = 40;
-    bo.box = 5.0f;
-    bo.speed = 0.05f;
-    bo.frames = 30;
-    bo.meshPath = ply.string();
-    auto scene = makeBunnySwarm(bo);
-    ASSERT_TRUE(scene->populate(engine).ok());
+    std::unique_ptr<DemoScene> scene;
+};
+
+TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
+    ASSERT_NO_FATAL_FAILURE(build("dyncull_conservative_", 30));
 
     const char* conservative = "vfc,simple,full,full-nohist,full-nobatch,full-noocc,full-notight,order,front10,oracle,thr64";
     auto modes = cli::modesFromList(conservative);
@@ -84,7 +101,7 @@ TEST(Conservative, EveryConservativeModeDrawsTheVfcImage) {
     // (llvmpipe on a loaded 2-core CI machine, or under the sanitizers) is counted visible
     // and would only make the no-timeout check below flaky. 20 s still ends every frame.
     for (cli::ModeSpec& m : *modes) m.scheduler.queryTimeoutMs = 20000.0;
-    auto runner = cli::BenchRunner::create(engine, *scene, modes.take());
+    auto runner = cli::BenchRunner::create(*engine, *scene, modes.take());
     ASSERT_TRUE(runner.ok()) << runner.error().message;
     const auto& names = (*runner)->result().modes;
     ASSERT_EQ(names[0].name, "vfc");
@@ -121,7 +138,6 @@ TEST(Conservative, EveryConservativeModeDrawsTheVfcImage) {
     EXPECT_GT(occludedSeen, 100u);
     EXPECT_GT(thresholdMisses, 0u) << "a 64-pixel threshold should drop some small visible parts";
     EXPECT_EQ(ctx->checkErrors(), 0u);
-    fs::remove_all(dir);
 }
 
 TEST(Conservative, SubdividedStaticModelsDrawTheVfcImage) {
@@ -169,31 +185,14 @@ TEST(Conservative, SubdividedStaticModelsDrawTheVfcImage) {
     fs::remove_all(dir);
 }
 
-TEST(Conservative, EveryQueryVolumeDrawsTheVfcImage) {
-    const fs::path dir = fs::temp_directory_path() / ("dyncull_conservative_volumes_" + std::to_string(::getpid()));
-    fs::create_directories(dir);
-    const fs::path ply = dir / "blob.ply";
-    writeBlobPly(ply, 48, 96);
-
-    auto ctx = test::headless(320, 180);
-    ASSERT_TRUE(ctx);
-    auto engineOr = Engine::create(*ctx);
-    ASSERT_TRUE(engineOr.ok());
-    Engine& engine = **engineOr;
-    BunnySwarmOptions bo;
-    bo.count = 40;
-    bo.box = 5.0f;
-    bo.speed = 0.05f;
-    bo.frames = 24;
-    bo.meshPath = ply.string();
-    auto scene = makeBunnySwarm(bo);
-    ASSERT_TRUE(scene->populate(engine).ok());
+TEST_F(ConservativeSwarm, EveryQueryVolumeDrawsTheVfcImage) {
+    ASSERT_NO_FATAL_FAILURE(build("dyncull_conservative_volumes_", 24));
 
     auto modes = cli::modesFromList("vfc,full");
     ASSERT_TRUE(modes.ok());
     auto expanded = cli::withVolumes(modes.take(), "aabb,obb,kdop14,kdop18,kdop26,auto");
     ASSERT_TRUE(expanded.ok()) << expanded.error().message;
-    auto runner = cli::BenchRunner::create(engine, *scene, expanded.take());
+    auto runner = cli::BenchRunner::create(*engine, *scene, expanded.take());
     ASSERT_TRUE(runner.ok()) << runner.error().message;
     const auto& names = (*runner)->result().modes;
     ASSERT_EQ(names.size(), 7u);
@@ -228,7 +227,6 @@ TEST(Conservative, EveryQueryVolumeDrawsTheVfcImage) {
     EXPECT_LE(drawn[kdop26], drawn[aabb]);
     EXPECT_GT(meshTriangles[kdop26], meshTriangles[aabb]);
     EXPECT_EQ(ctx->checkErrors(), 0u);
-    fs::remove_all(dir);
 }
 
 }  // namespace
