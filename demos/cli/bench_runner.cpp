@@ -53,7 +53,7 @@ std::string modeNamesHelp() {
            "skipN (history max skip N, 2 per visible), overlap (overlapping batches), smallN (small-feature pixels); "
            "backend: noflush (no glFlush after each batch); "
            "conservative: frontN (front-most N% of leaves drawn without queries); "
-           "ablations: full-nohist, full-nobatch, full-noocc, full-notight; order (waiting nodes hold back farther overlapping ones); settings of full combine with '+' "
+           "ablations: full-nohist, full-nobatch, full-noocc, full-notight, full-nodrawq; order (waiting nodes hold back farther overlapping ones); settings of full combine with '+' "
            "(thr16+latency1), including a query volume: aabb, obb, kdop14, kdop18, kdop26, auto (full+kdop26)";
 }
 
@@ -133,6 +133,8 @@ bool applyFullSetting(const std::string& part, ModeSpec& m) {
         m.scheduler.useOccupancyAccept = false;
     } else if (part == "full-notight") {
         m.scheduler.useTightVolumes = false;
+    } else if (part == "full-nodrawq") {
+        m.scheduler.useDrawQueries = false;
     } else if (part == "order") {
         m.scheduler.useWaitOrder = true;
     } else if (numberAfter(part, "thr", n)) {

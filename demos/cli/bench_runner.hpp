@@ -35,7 +35,7 @@ struct ModeSpec {
 /// latency1 (last frame's results), skipN (history: max skip N, 2 frames per visible
 /// answer), overlap (overlapping batches), smallN (small-feature culling below N pixels);
 /// frontN (conservative: the front-most N% of frustum leaves drawn without queries);
-/// ablations full-nohist, full-nobatch, full-noocc, full-notight. Settings of full combine
+/// ablations full-nohist, full-nobatch, full-noocc, full-notight, full-nodrawq. Settings of full combine
 /// with '+' (thr16+latency1); one of them may be a query volume (aabb, obb, kdop14, kdop18,
 /// kdop26, auto: full+kdop26, thr16+obb) for modes that query node volumes
 /// (queriesNodeVolumes). Error names the mode.

@@ -166,7 +166,8 @@ Status writeFramesCsv(const BenchResult& r, const fs::path& path) {
     f << "frame,mode,ms_frame,ms_traversal,ms_query,ms_wait,ms_draw,ms_update,queries,queries_occluded,queries_timed_out,"
          "skipped_history,skipped_occupancy,visible_near,frustum_culled,small_feature_culled,nodes_visited,batches,"
          "parts,triangles,visible_parts,frustum_parts,false_negatives,false_negative_pixels,false_positives,"
-         "pixels_wrong,pixels_wrong_pct,largest_wrong_region,frame_update_ms,ground_truth_ms,ground_truth_artefact_pixels\n";
+         "pixels_wrong,pixels_wrong_pct,largest_wrong_region,frame_update_ms,ground_truth_ms,ground_truth_artefact_pixels,"
+         "draw_queries,draw_queries_occluded,draw_queries_late\n";
     for (std::size_t i = 0; i < r.frames.size(); ++i) {
         const FrameTruth& t = r.truth[i];
         for (std::size_t m = 0; m < r.modes.size(); ++m) {
@@ -180,7 +181,8 @@ Status writeFramesCsv(const BenchResult& r, const fs::path& path) {
               << s.nodesVisited << ',' << s.batches << ',' << s.partsDrawn << ',' << s.trianglesDrawn << ','
               << t.visibleParts << ',' << t.frustumParts << ',' << p.falseNegatives << ',' << p.falseNegativePixels
               << ',' << p.falsePositives << ',' << d.differingPixels << ',' << d.percentDiffering << ','
-              << d.largestRegion << ',' << t.updateMs << ',' << t.groundTruthMs << ',' << t.artefactPixels << '\n';
+              << d.largestRegion << ',' << t.updateMs << ',' << t.groundTruthMs << ',' << t.artefactPixels << ','
+              << s.drawQueries << ',' << s.drawQueriesOccluded << ',' << s.drawQueriesLate << '\n';
         }
     }
     if (!f) return Error{path.string() + ": write failed"};

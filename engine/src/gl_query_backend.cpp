@@ -125,8 +125,38 @@ QueryId GlQueryBackend::acquireSlot() {
     return id;
 }
 
+QueryId GlQueryBackend::startQuery() {
+    const QueryId id = acquireSlot();
+    Slot& s = queries_[id];
+    const std::uint32_t target = params_.visiblePixelThreshold > 0 ? GL_SAMPLES_PASSED : GL_ANY_SAMPLES_PASSED_CONSERVATIVE;
+    if (s.target != target) {
+        // A query object is bound to the target it was created for.
+        glDeleteQueries(1, &s.name);
+        glCreateQueries(target, 1, &s.name);
+        s.target = target;
+    }
+    s.live = true;
+    s.result = QueryResult::NotReady;
+    s.samples = 0;
+    return id;
+}
+
+QueryId GlQueryBackend::beginDrawQuery() {
+    assert(!inBatch_ && !inDrawQuery_);
+    inDrawQuery_ = true;
+    const QueryId id = startQuery();
+    glBeginQuery(queries_[id].target, queries_[id].name);
+    return id;
+}
+
+void GlQueryBackend::endDrawQuery(QueryId id) {
+    assert(inDrawQuery_ && queries_[id].live);
+    inDrawQuery_ = false;
+    glEndQuery(queries_[id].target);
+}
+
 void GlQueryBackend::beginBatch() {
-    assert(!inBatch_);
+    assert(!inBatch_ && !inDrawQuery_);
     inBatch_ = true;
     savedCull_ = glIsEnabled(GL_CULL_FACE);
     savedDepthTest_ = glIsEnabled(GL_DEPTH_TEST);
@@ -206,19 +236,9 @@ QueryId GlQueryBackend::issue(const QueryVolume& volume) {
         glBindVertexArray(boundMesh_ ? meshVao_ : boxVao_);
     }
 
-    const QueryId id = acquireSlot();
-    Slot& s = queries_[id];
-    const std::uint32_t target = params_.visiblePixelThreshold > 0 ? GL_SAMPLES_PASSED : GL_ANY_SAMPLES_PASSED_CONSERVATIVE;
-    if (s.target != target) {
-        // A query object is bound to the target it was created for.
-        glDeleteQueries(1, &s.name);
-        glCreateQueries(target, 1, &s.name);
-        s.target = target;
-    }
-    s.live = true;
-    s.result = QueryResult::NotReady;
-    s.samples = 0;
-    glBeginQuery(target, s.name);
+    const QueryId id = startQuery();
+    const std::uint32_t target = queries_[id].target;
+    glBeginQuery(target, queries_[id].name);
     if (volume.isBox()) {
         glDrawElementsBaseVertex(GL_TRIANGLES, 36, GL_UNSIGNED_BYTE, nullptr, static_cast<GLint>(vboUsed_));
     } else {

@@ -103,6 +103,11 @@ FrameStats QueryScheduler::cullFrame(const TwoLevelTree& tree, const Camera& cam
     frontBudget_ = frontLeavesSeen_ = 0;
     if (params_.mode != CullMode::Vfc && params_.frontPercent > 0.0f && !rootBox.empty())
         frontBudget_ = static_cast<std::uint32_t>(std::ceil(double(params_.frontPercent) / 100.0 * countFrustumLeaves()));
+    if (params_.mode != CullMode::Full) {
+        // Switched away from Full: its last draw queries will not be read.
+        for (const Pending& p : drawQueries_) backend.release(p.id);
+        drawQueries_.clear();
+    }
     switch (params_.mode) {
         case CullMode::Vfc: runVfc(); break;
         case CullMode::Simple: runSimple(); break;
@@ -268,11 +273,21 @@ QueryVolume QueryScheduler::queryVolume(NodeRef ref, const Aabb& worldBox) const
     return QueryVolume::fromNodeVolume(m, model.volumes, v);
 }
 
-void QueryScheduler::drawNode(NodeRef ref) {
+void QueryScheduler::drawNode(NodeRef ref, bool untested) {
     const SceneObjects& objs = tree_->objects();
     const LocalBspNode& n = objs.model(objs.modelOf(ref.object)).nodes[ref.node];
     const auto t0 = Clock::now();
-    sink_->drawPart(ref.object, n.firstIndex, n.indexCount);
+    if (untested && params_.mode == CullMode::Full && params_.useDrawQueries) {
+        const QueryId id = backend_->beginDrawQuery();
+        sink_->drawPart(ref.object, n.firstIndex, n.indexCount);
+        if (id != kNoQuery) {
+            backend_->endDrawQuery(id);
+            drawQueries_.push_back({ref, id, {}, false});
+            ++stats_->drawQueries;
+        }
+    } else {
+        sink_->drawPart(ref.object, n.firstIndex, n.indexCount);
+    }
     stats_->drawMs += msSince(t0);
     ++stats_->partsDrawn;
     stats_->trianglesDrawn += n.indexCount / 3;
@@ -283,12 +298,12 @@ void QueryScheduler::drawNode(NodeRef ref) {
     }
 }
 
-void QueryScheduler::processVisible(NodeRef ref, NodeHistory& h) {
+void QueryScheduler::processVisible(NodeRef ref, NodeHistory& h, bool untested) {
     // Algorithm 4: draw a part, or replace the node by its children front-to-back.
     h.lastVisible = true;
     h.lastVisibleFrame = frame_;
     if (tree_->isDrawable(ref)) {
-        drawNode(ref);
+        drawNode(ref, untested);
         return;
     }
     scratch_.clear();
@@ -346,7 +361,7 @@ void QueryScheduler::runVfc() {
         NodeHistory& h = history_.at(ref, tree_->objects());
         h.lastTouchedFrame = frame_;
         if (trace_) trace(ref, tree_->worldBox(ref), NodeState::VisibleVfc);
-        processVisible(ref, h);
+        processVisible(ref, h, false);
     }
 }
 
@@ -380,7 +395,7 @@ void QueryScheduler::runSimple() {
                 continue;
             }
         }
-        processVisible(ref, h);
+        processVisible(ref, h, false);
     }
 }
 
@@ -393,7 +408,7 @@ void QueryScheduler::finishQuery(Pending& p, QueryResult r) {
     history_.recordAnswer(h, visible, frame_);
     if (trace_) trace(p.node, tree_->worldBox(p.node), visible ? NodeState::VisibleQueried : NodeState::Occluded);
     if (visible)
-        processVisible(p.node, h);
+        processVisible(p.node, h, false);
     else
         ++stats_->queriesOccluded;
 }
@@ -417,6 +432,30 @@ void QueryScheduler::collectLatent(bool block) {
         }
         latent_[i] = latent_.back();
         latent_.pop_back();
+    }
+}
+
+void QueryScheduler::collectDrawAnswers() {
+    // Last frame's draw queries. A part already reached this frame keeps this frame's
+    // decision (the answer is older); an unanswered query is polled again later.
+    const SceneObjects& objs = tree_->objects();
+    for (std::size_t i = 0; i < drawAnswers_.size();) {
+        const Pending& p = drawAnswers_[i];
+        const QueryResult r = timedPoll(p.id);
+        if (r == QueryResult::NotReady) {
+            ++i;
+            continue;
+        }
+        backend_->release(p.id);
+        if (p.node.object < objs.slotCount() && objs.alive(p.node.object)) {
+            NodeHistory& h = history_.at(p.node, objs);
+            if (h.lastTouchedFrame != frame_) {
+                history_.recordAnswer(h, r != QueryResult::Occluded, frame_ - 1);
+                if (r == QueryResult::Occluded) ++stats_->drawQueriesOccluded;
+            }
+        }
+        drawAnswers_[i] = drawAnswers_.back();
+        drawAnswers_.pop_back();
     }
 }
 
@@ -495,19 +534,24 @@ void QueryScheduler::runFull() {
         history_.recordAnswer(h, true, frame_);
         trace(ref, box, NodeState::VisibleOccupancy);
         closeBatch();
-        processVisible(ref, h);
+        processVisible(ref, h, true);
         return true;
     };
 
     waitingMap_.clear();
     bool answered = false;  // a query finished since waiting nodes were last retried
     collectLatent(false);
+    // Last frame's draw queries become this frame's answers to read; never waited for.
+    drawAnswers_.swap(drawQueries_);
+    drawQueries_.clear();
+    collectDrawAnswers();
 
     while (!active_.empty() || !deferred.empty() || !pending_.empty()) {
         bool progress = false;
 
         // 1. Finish answered queries, oldest first; visible ones push their children.
         closeBatch();
+        if (!drawAnswers_.empty()) collectDrawAnswers();
         for (std::size_t i = 0; i < pending_.size();) {
             const QueryResult r = timedPoll(pending_[i].id);
             if (r == QueryResult::NotReady) {
@@ -533,7 +577,7 @@ void QueryScheduler::runFull() {
             if (ft == FirstTest::Invisible) continue;
             if (ft == FirstTest::Visible) {
                 closeBatch();
-                processVisible(ref, h);
+                processVisible(ref, h, true);
                 continue;
             }
             ScreenRect rect;
@@ -558,7 +602,7 @@ void QueryScheduler::runFull() {
                 }
                 trace(ref, box, NodeState::VisibleQueried);
                 closeBatch();
-                processVisible(ref, h);
+                processVisible(ref, h, false);
             }
         }
 
@@ -596,6 +640,11 @@ void QueryScheduler::runFull() {
         }
     }
     closeBatch();
+    // Answers that have not arrived by now would be two frames old at the next read:
+    // dropped, so those parts keep their history.
+    stats_->drawQueriesLate += static_cast<std::uint32_t>(drawAnswers_.size());
+    for (const Pending& p : drawAnswers_) backend_->release(p.id);
+    drawAnswers_.clear();
 }
 
 }  // namespace dyncull

@@ -94,7 +94,7 @@ protected:
 TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
     ASSERT_NO_FATAL_FAILURE(build("dyncull_conservative_", 30));
 
-    const char* conservative = "vfc,simple,full,full-nohist,full-nobatch,full-noocc,full-notight,order,front10,oracle,thr64";
+    const char* conservative = "vfc,simple,full,full-nohist,full-nobatch,full-noocc,full-notight,full-nodrawq,order,front10,oracle,thr64";
     auto modes = cli::modesFromList(conservative);
     ASSERT_TRUE(modes.ok()) << modes.error().message;
     // The test checks culling, not latency: a query that outlasts the default 250 ms bound
@@ -106,7 +106,7 @@ TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
     const auto& names = (*runner)->result().modes;
     ASSERT_EQ(names[0].name, "vfc");
 
-    std::uint64_t visibleSeen = 0, thresholdMisses = 0, occludedSeen = 0, queries = 0;
+    std::uint64_t visibleSeen = 0, thresholdMisses = 0, occludedSeen = 0, queries = 0, drawQueriesOccluded = 0;
     double worstPercent = 0.0;
     for (std::uint64_t frame = 0; frame < bo.frames; ++frame) {
         ASSERT_TRUE((*runner)->runFrame(frame).ok());
@@ -125,6 +125,7 @@ TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
             SCOPED_TRACE(names[m].name + " frame " + std::to_string(frame));
             worstPercent = std::max(worstPercent, row[m].image.percentDiffering);
             queries += row[m].stats.queriesIssued;
+            if (names[m].name == "full") drawQueriesOccluded += row[m].stats.drawQueriesOccluded;
             EXPECT_LE(row[m].image.percentDiffering, 0.01);
             EXPECT_EQ(row[m].parts.falseNegatives, 0u);
             EXPECT_EQ(row[m].stats.queriesTimedOut, 0u);
@@ -137,6 +138,8 @@ TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
     EXPECT_GT(visibleSeen, 100u);
     EXPECT_GT(occludedSeen, 100u);
     EXPECT_GT(thresholdMisses, 0u) << "a 64-pixel threshold should drop some small visible parts";
+    // Real GL draw queries answered, and some parts drawn untested turned out hidden.
+    EXPECT_GT(drawQueriesOccluded, 0u);
     EXPECT_EQ(ctx->checkErrors(), 0u);
 }
 

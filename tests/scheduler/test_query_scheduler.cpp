@@ -541,6 +541,144 @@ TEST(QueryVolume, NodeVolumesAreTransformedVertexByVertex) {
     for (int i = 0; i < 8; ++i) EXPECT_EQ(a.vertices[i], b.vertices[i]);
 }
 
+// ---- Draw queries: parts drawn without a query of their own are drawn inside a query
+// on their geometry; its answer decides the part's next frame.
+
+namespace {
+
+// Box queries as ScriptedBackend (always visible, answered at once); draw queries
+// answered per object by `drawRule` (NotReady: never answers), the object being the one
+// the sink drew inside the query.
+struct DrawQueryBackend final : QueryBackend {
+    static constexpr QueryId kDrawBase = 1u << 20;
+    std::function<QueryResult(std::uint32_t object)> drawRule = [](std::uint32_t) { return QueryResult::Visible; };
+    std::vector<std::uint32_t> drawObject;  // per draw query: object drawn inside it
+    std::vector<bool> live;                 // per draw query
+    std::vector<QueryVolume> boxes;         // box queries of the current frame
+    int boxIssued = 0, boxReleased = 0, drawReleased = 0;
+    bool inDraw = false;
+    std::uint32_t lastDrawn = ~0u;  // written by the sink
+
+    void beginFrame(const Camera&, int, int) override { boxes.clear(); }
+    void beginBatch() override { EXPECT_FALSE(inDraw); }
+    QueryId issue(const QueryVolume& v) override {
+        boxes.push_back(v);
+        return static_cast<QueryId>(boxIssued++);
+    }
+    void endBatch() override {}
+    QueryResult poll(QueryId id) override {
+        if (id < kDrawBase) return QueryResult::Visible;
+        EXPECT_TRUE(live[id - kDrawBase]);
+        return drawRule(drawObject[id - kDrawBase]);
+    }
+    QueryResult wait(QueryId id, double) override {
+        const QueryResult r = poll(id);
+        return r == QueryResult::NotReady ? QueryResult::NotReady : r;
+    }
+    void release(QueryId id) override {
+        if (id < kDrawBase) {
+            ++boxReleased;
+            return;
+        }
+        EXPECT_TRUE(live[id - kDrawBase]);
+        live[id - kDrawBase] = false;
+        ++drawReleased;
+    }
+    QueryId beginDrawQuery() override {
+        EXPECT_FALSE(inDraw);
+        inDraw = true;
+        lastDrawn = ~0u;
+        drawObject.push_back(~0u);
+        live.push_back(true);
+        return kDrawBase + static_cast<QueryId>(drawObject.size() - 1);
+    }
+    void endDrawQuery(QueryId id) override {
+        EXPECT_TRUE(inDraw);
+        inDraw = false;
+        drawObject[id - kDrawBase] = lastDrawn;
+    }
+    /// Box queries this frame on a volume centred at x (the cubes of TestScene(3, 1) sit
+    /// at x = -1, 0, 1; larger scene-node boxes are not counted).
+    int objectQueriesAt(float x) const {
+        int n = 0;
+        for (const QueryVolume& v : boxes) {
+            Aabb b;
+            for (const glm::vec3& q : v.points()) b.extend(q);
+            if (b.extent().x < 1.0f && std::abs(b.center().x - x) < 1e-3f) ++n;
+        }
+        return n;
+    }
+};
+
+struct ForwardingSink final : PartSink {
+    DrawQueryBackend& backend;
+    std::multiset<std::uint32_t> drawn;
+    explicit ForwardingSink(DrawQueryBackend& b) : backend(b) {}
+    void drawPart(std::uint32_t object, std::uint32_t, std::uint32_t) override {
+        drawn.insert(object);
+        backend.lastDrawn = object;
+    }
+};
+
+}  // namespace
+
+TEST(QueryScheduler, DrawQueriesKeepVisiblePartsUnqueriedAndRequeryPartsThatDrewNothing) {
+    TestScene s(3, 1);
+    const auto reference = vfcDrawn(s);
+    ASSERT_EQ(reference.size(), 3u);
+    for (bool drawQueries : {true, false}) {
+        SCOPED_TRACE(drawQueries ? "draw queries" : "history only");
+        DrawQueryBackend b;
+        SchedulerParams p;
+        p.useOccupancyAccept = false;  // every part needs a query or history
+        p.history.jitter = false;
+        p.useDrawQueries = drawQueries;
+        QueryScheduler sched(p);
+        TwoLevelTree tree(s.bsp, s.objects);
+        auto frame = [&] {
+            ForwardingSink sink(b);
+            const FrameStats st = sched.cullFrame(tree, frontCamera(), 640, 320, b, sink);
+            EXPECT_EQ(sink.drawn, reference);  // every box answers visible: nothing is culled
+            return st;
+        };
+        // Every geometry visible: after two box answers a part is never box-queried again
+        // with draw queries; history alone re-queries it within maxSkipFrames.
+        int requeries = 0;
+        for (int f = 0; f < 20; ++f) {
+            const FrameStats st = frame();
+            if (f >= 3) requeries += b.objectQueriesAt(-1.0f) + b.objectQueriesAt(0.0f) + b.objectQueriesAt(1.0f);
+            if (f >= 3) EXPECT_EQ(st.drawQueries, drawQueries ? 3u : 0u);  // the three parts, skipped by history
+        }
+        if (drawQueries)
+            EXPECT_EQ(requeries, 0);
+        else
+            EXPECT_GT(requeries, 0);
+
+        // The left cube's geometry drew nothing last frame (answers are read at the start
+        // of the next frame): with draw queries it is queried by box now, the others are
+        // not; history alone skips it.
+        b.drawRule = [](std::uint32_t object) { return object == 0 ? QueryResult::Occluded : QueryResult::Visible; };
+        const FrameStats st = frame();
+        b.drawRule = [](std::uint32_t) { return QueryResult::Visible; };
+        EXPECT_EQ(b.objectQueriesAt(-1.0f), drawQueries ? 1 : 0);
+        EXPECT_EQ(b.objectQueriesAt(0.0f) + b.objectQueriesAt(1.0f), 0);
+        EXPECT_EQ(st.drawQueriesOccluded, drawQueries ? 1u : 0u);
+
+        // Draw queries that never answer are dropped at the frame's end (history decides
+        // as without them) and every one is released.
+        b.drawRule = [](std::uint32_t) { return QueryResult::NotReady; };
+        std::uint32_t late = 0;
+        for (int f = 0; f < 12; ++f) late += frame().drawQueriesLate;
+        if (drawQueries) EXPECT_GT(late, 0u);
+        b.drawRule = [](std::uint32_t) { return QueryResult::Visible; };
+        p.mode = CullMode::Vfc;  // leaving Full releases the last frame's draw queries
+        sched.setParams(p);
+        frame();
+        EXPECT_EQ(b.drawReleased, static_cast<int>(b.drawObject.size()));
+        EXPECT_EQ(b.boxReleased, b.boxIssued);
+    }
+}
+
 // ---- Faults: a backend that never answers (lost or hung GPU). The contract of
 // QueryBackend::wait is a bounded wait; the scheduler must then count the node visible
 // (never cull on a missing answer) and end the frame.

@@ -41,6 +41,8 @@ public:
     QueryResult wait(QueryId id, double timeoutMs) override;
     void release(QueryId id) override;
     std::uint64_t samples(QueryId id) const override;
+    QueryId beginDrawQuery() override;
+    void endDrawQuery(QueryId id) override;
 
     const GlQueryParams& params() const { return params_; }
     void setParams(const GlQueryParams& p) { params_ = p; }
@@ -56,6 +58,8 @@ private:
     GlQueryBackend(GlContext& context, GlQueryParams params) : context_(context), params_(params) {}
     QueryResult fetch(QueryId id);
     QueryId acquireSlot();
+    /// A free query object for the current threshold's target, marked live and unanswered.
+    QueryId startQuery();
     /// (Re)allocates a streaming buffer with glNamedBufferData; on failure records the
     /// error in frameStatus_ and enters the degraded state.
     bool allocate(std::uint32_t buffer, std::size_t bytes, const char* what);
@@ -84,6 +88,7 @@ private:
     int savedDepthFunc_ = 0;
     bool savedCull_ = false, savedDepthTest_ = false;
     bool inBatch_ = false;
+    bool inDrawQuery_ = false;
     bool degraded_ = false;  // an allocation failed this frame: queries answer Visible
     Status frameStatus_;
 };

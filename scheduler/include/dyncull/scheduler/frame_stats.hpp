@@ -16,6 +16,10 @@ struct FrameStats {
     std::uint64_t queryTriangles = 0;   ///< triangles of the query volumes drawn (12 per box)
     std::uint32_t queriesOccluded = 0;  ///< answered "occluded"
     std::uint32_t queriesTimedOut = 0;  ///< never answered within the bound; counted visible
+    /// Queries on parts drawn without a query (SchedulerParams::useDrawQueries); not in queriesIssued.
+    std::uint32_t drawQueries = 0;
+    std::uint32_t drawQueriesOccluded = 0;  ///< last frame's draw queries read this frame that drew no sample
+    std::uint32_t drawQueriesLate = 0;      ///< last frame's draw queries still unanswered at this frame's end (dropped)
     std::uint32_t skippedByHistory = 0;  ///< queries not issued thanks to visibility history
     std::uint32_t skippedByOccupancy = 0;  ///< visible without a query: rectangle touched empty screen
     std::uint32_t visibleNearOrInside = 0;  ///< visible without a query: camera inside / near plane crossed

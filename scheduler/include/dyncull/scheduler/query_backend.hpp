@@ -51,6 +51,8 @@ struct QueryVolume {
 };
 
 using QueryId = std::uint32_t;
+/// Returned by a backend that cannot query a draw (QueryBackend::beginDrawQuery).
+inline constexpr QueryId kNoQuery = 0xffffffffu;
 
 class QueryBackend {
 public:
@@ -78,6 +80,13 @@ public:
     /// Number of samples that passed for an answered query (0 if unknown). Used by
     /// threshold settings and statistics.
     virtual std::uint64_t samples(QueryId) const { return 0; }
+    /// A query on the geometry itself (coherent hierarchical culling's query on a
+    /// previously visible leaf): counts the samples of what is drawn through the PartSink
+    /// until endDrawQuery, with the same answer rule as issue(). Outside a batch, one at a
+    /// time; answered, released and timed out like any query. kNoQuery if the backend
+    /// cannot (the default), and the scheduler then relies on visibility history alone.
+    virtual QueryId beginDrawQuery() { return kNoQuery; }
+    virtual void endDrawQuery(QueryId) {}
 };
 
 /// What the scheduler calls to draw an object part: slot `object` of SceneObjects, the

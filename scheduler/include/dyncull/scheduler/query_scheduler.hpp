@@ -43,6 +43,14 @@ struct SchedulerParams {
     /// hence off; a GPU, where overdraw costs more than a stall, may differ.
     bool useWaitOrder = false;
 
+    /// Every part drawn without a query of its own (history, occupancy, near plane,
+    /// front-most) is drawn inside a query on its geometry; next frame a part whose
+    /// geometry drew no sample is queried again instead of being skipped by history.
+    /// Coherent hierarchical culling's query on previously visible leaves (Bittner et al.
+    /// 2004, which the two-level paper cites): it catches visible -> hidden at once
+    /// instead of after up to history.maxSkipFrames frames, with no volume to rasterise.
+    bool useDrawQueries = true;
+
     HistoryParams history;
     std::uint32_t maxQueriesInFlight = 64;
     int occupancyTileSize = 16;  ///< pixels per tile side of both occupancy maps
@@ -140,8 +148,11 @@ private:
     enum class FirstTest : std::uint8_t { Invisible, Visible, NeedQuery };
 
     FirstTest firstVisibilityTest(NodeRef ref, const Aabb& box, NodeHistory& h, FrameStats& st);
-    void processVisible(NodeRef ref, NodeHistory& h);
-    void drawNode(NodeRef ref);
+    /// `untested`: decided visible without a query this frame (gets a draw query).
+    void processVisible(NodeRef ref, NodeHistory& h, bool untested);
+    void drawNode(NodeRef ref, bool untested);
+    /// Records last frame's draw-query answers that have arrived (non-blocking).
+    void collectDrawAnswers();
     QueryVolume queryVolume(NodeRef ref, const Aabb& worldBox) const;
     bool projectRect(const Aabb& box, ScreenRect& out) const;
     void finishQuery(Pending& p, QueryResult r);
@@ -178,6 +189,8 @@ private:
     std::vector<NodeTrace>* trace_ = nullptr;
     // useLastFrameResults: queries issued in an earlier frame, read when they answer.
     std::vector<Pending> latent_;
+    // useDrawQueries: this frame's draw queries, and last frame's not yet read.
+    std::vector<Pending> drawQueries_, drawAnswers_;
 
     void trace(NodeRef ref, const Aabb& box, NodeState s) {
         if (trace_) trace_->push_back({ref, box, s});
