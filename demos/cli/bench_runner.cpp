@@ -284,6 +284,7 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
     ft.frustumParts = truth_.candidates;
     ft.coveredPixels = truth_.coveredPixels;
     ft.artefactPixels = truth_.artefactPixels;
+    for (const PartKey& k : truth_.parts) ft.visibleTriangles += engine_.objects().model(engine_.objects().modelOf(k.object)).nodes[k.node].indexCount / 3;
 
     // The oracle draws the visible parts front-to-back like the other modes, so it gets
     // the same early-depth rejection and is a fair lower bound.
@@ -309,7 +310,9 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
         const ModeSpec& spec = result_.modes[m];
         engine_.setQueryParams(spec.queries);
         recorder_.clear();
+        if (schedulers_[m]) schedulers_[m]->setTrace(&trace_);
         auto rendered = spec.oracle ? engine_.renderParts(oracleParts_) : engine_.renderFrame(*schedulers_[m]);
+        if (schedulers_[m]) schedulers_[m]->setTrace(nullptr);
         if (!rendered) {
             engine_.setPartObserver(nullptr);
             return Error{"frame " + std::to_string(frame) + ", mode " + spec.name + ": " + rendered.error().message};
@@ -323,11 +326,81 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
             return Error{diff.error().message};
         }
         row[m].image = *diff;
+        if (!spec.oracle) row[m].falsePositiveCauses = falsePositiveCauses();
+        if (m == 0 && measureBound_) {
+            // vfc drew everything in the frustum: its depth buffer is the frame's final depth.
+            ft.boundMeasured = true;
+            ft.boundAabb = volumeBound(VolumeChoice::Aabb);
+            ft.boundAuto = volumeBound(VolumeChoice::Auto);
+        }
     }
     engine_.setPartObserver(nullptr);
     result_.truth.push_back(ft);
     result_.frames.push_back(std::move(row));
     return {};
+}
+
+FalsePositiveCauses BenchRunner::falsePositiveCauses() const {
+    // Every leaf is decided once per frame, so each drawn leaf has one visible state.
+    FalsePositiveCauses c;
+    const TwoLevelTree tree(engine_.sceneTree(), engine_.objects());
+    for (const NodeTrace& t : trace_) {
+        if (t.ref.isSceneNode() || !tree.isDrawable(t.ref) || truth_.contains(PartKey{t.ref.object, t.ref.node})) continue;
+        switch (t.state) {
+            case NodeState::FrustumCulled:
+            case NodeState::Occluded:
+            case NodeState::SmallFeature: break;
+            case NodeState::VisibleQueried: ++c.queried; break;
+            case NodeState::VisibleHistory: ++c.history; break;
+            case NodeState::VisibleOccupancy: ++c.occupancy; break;
+            case NodeState::VisibleNear:
+            case NodeState::VisibleFront:
+            case NodeState::VisibleVfc: ++c.other; break;
+        }
+    }
+    return c;
+}
+
+VolumeBound BenchRunner::volumeBound(VolumeChoice volume) {
+    const SceneObjects& objs = engine_.objects();
+    const Camera& cam = engine_.camera();
+    const TwoLevelTree tree(engine_.sceneTree(), objs);
+    auto nearPlaneReached = [&](NodeRef r) {
+        // Any corner of its world box closer along the view direction than the near plane
+        // (with 0.1% to spare: the scheduler's own test is tighter, this one only has to be safe).
+        const Aabb box = tree.worldBox(r);
+        const glm::vec3 f = cam.forward();
+        for (int c = 0; c < 8; ++c) {
+            const glm::vec3 p((c & 1) ? box.max.x : box.min.x, (c & 2) ? box.max.y : box.min.y, (c & 4) ? box.max.z : box.min.z);
+            if (glm::dot(p - cam.position, f) < cam.nearPlane * 1.001f) return true;
+        }
+        return false;
+    };
+    const std::vector<NodeRef>& parts = groundTruth_->lastParts();
+    QueryBackend& backend = engine_.queryBackend();
+    backend.beginFrame(engine_.camera(), result_.width, result_.height);
+    VolumeBound b;
+    std::vector<QueryId> ids;
+    constexpr std::size_t kBatch = 512;  // bounds the query objects in flight
+    for (std::size_t i = 0; i < parts.size(); i += kBatch) {
+        const std::size_t n = std::min(kBatch, parts.size() - i);
+        ids.clear();
+        backend.beginBatch();
+        for (std::size_t j = 0; j < n; ++j)
+            ids.push_back(backend.issue(objectNodeVolume(objs, parts[i + j], volume, SchedulerParams{}.autoVolumeSaving)));
+        backend.endBatch();
+        for (std::size_t j = 0; j < n; ++j) {
+            // Unanswered within the bound counts visible, as in the scheduler; so does a
+            // part reaching the near plane, whose query could be clipped away.
+            const NodeRef r = parts[i + j];
+            if (backend.wait(ids[j], 60000.0) != QueryResult::Occluded || nearPlaneReached(r)) {
+                ++b.parts;
+                b.triangles += objs.model(objs.modelOf(r.object)).nodes[r.node].indexCount / 3;
+            }
+            backend.release(ids[j]);
+        }
+    }
+    return b;
 }
 
 void BenchRunner::measureLeafVolumes() {
@@ -371,6 +444,7 @@ Status runMeasurement(const MeasureOptions& o, std::vector<ModeSpec> modes, cons
 
     auto runner = BenchRunner::create(engine, scene, std::move(modes));
     if (!runner) return Error{runner.error().message};
+    (*runner)->setMeasureVolumeBound(o.volumeBound);
     std::string names;
     for (const ModeSpec& m : (*runner)->result().modes) names += (names.empty() ? "" : ",") + m.name;
     std::printf("modes (interleaved per frame, vfc first): %s\n", names.c_str());

@@ -62,11 +62,29 @@ std::string modeNamesHelp();
 Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec);
 std::string sweepParamsHelp();
 
+/// Why a mode drew its false positives (drawn parts with no visible pixel): the decision
+/// the scheduler's trace records for each such leaf.
+struct FalsePositiveCauses {
+    std::uint32_t queried = 0;    ///< a query of its volume answered visible
+    std::uint32_t history = 0;    ///< drawn untested: visible in recent frames
+    std::uint32_t occupancy = 0;  ///< drawn untested: its rectangle touched empty screen
+    std::uint32_t other = 0;      ///< drawn untested: near plane crossed, front-most leaves, or vfc
+};
+
 /// What one mode did in one frame.
 struct ModeFrame {
     FrameStats stats;
     PartErrors parts;   ///< against the ground-truth visible set
     ImageDiff image;    ///< against the vfc image of the same frame
+    FalsePositiveCauses falsePositiveCauses;  ///< parts.falsePositives by cause (scheduler modes)
+};
+
+/// Parts whose query volume passes a query against the frame's final depth (all of vfc's
+/// drawing): what a conservative query-based mode with that volume must draw at least if
+/// it had perfect order and no history. Measured only with --volume-bound.
+struct VolumeBound {
+    std::uint32_t parts = 0;
+    std::uint64_t triangles = 0;
 };
 
 /// Per-frame facts independent of the mode.
@@ -77,6 +95,9 @@ struct FrameTruth {
     double groundTruthMs = 0.0;       ///< ID pass (not counted in any mode's time)
     double updateMs = 0.0;            ///< loose-BSP relink, once per frame for all modes
     std::uint32_t artefactPixels = 0; ///< ID-pass pixels dropped as depth artefacts (VisibleSet::artefactPixels)
+    std::uint64_t visibleTriangles = 0;  ///< triangles of the visible parts (what the oracle draws)
+    bool boundMeasured = false;          ///< the two bounds below were measured (--volume-bound)
+    VolumeBound boundAabb, boundAuto;    ///< with transformed local boxes, and with the auto volumes
 };
 
 struct BenchResult {
@@ -100,6 +121,9 @@ public:
 
     /// Moves the scene to `frame`, computes the truth and renders every mode; appends to result().
     Status runFrame(std::uint64_t frame);
+    /// Also measure the volume bounds (FrameTruth::boundAabb, boundAuto) each frame:
+    /// two queries per part in the frustum, untimed.
+    void setMeasureVolumeBound(bool on) { measureBound_ = on; }
     /// Fills result().leafTotals from the scene as it is now (call after the last frame).
     void measureLeafVolumes();
 
@@ -120,6 +144,12 @@ private:
     VisibleSet truth_;
     std::vector<Image> images_;
     std::vector<NodeRef> oracleParts_;
+    std::vector<NodeTrace> trace_;
+    bool measureBound_ = false;
+
+    /// Queries the volume of every part in the frustum against the depth buffer as it is.
+    VolumeBound volumeBound(VolumeChoice volume);
+    FalsePositiveCauses falsePositiveCauses() const;
 };
 
 /// What `dyncull bench` and `dyncull sweep` share: scene, frames, size, output directory.
@@ -132,6 +162,7 @@ struct MeasureOptions {
     std::string out;  ///< output directory; empty: out/measure_<scene>
     SceneOptions sceneOptions;
     bool quiet = false;  ///< no progress lines on stderr
+    bool volumeBound = false;  ///< BenchRunner::setMeasureVolumeBound
 };
 
 /// Creates a headless context and engine, populates the scene, runs `modes` interleaved

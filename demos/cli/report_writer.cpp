@@ -95,6 +95,12 @@ std::vector<ModeSummary> summarise(const BenchResult& r) {
             s.falseNegatives += f.parts.falseNegatives;
             s.falseNegativePixels += f.parts.falseNegativePixels;
             s.falsePositives += f.parts.falsePositives;
+            s.fpQueried += f.falsePositiveCauses.queried;
+            s.fpHistory += f.falsePositiveCauses.history;
+            s.fpOccupancy += f.falsePositiveCauses.occupancy;
+            s.fpOther += f.falsePositiveCauses.other;
+            s.drawQueries += f.stats.drawQueries;
+            s.drawQueriesOccluded += f.stats.drawQueriesOccluded;
             s.largestRegion = std::max(s.largestRegion, f.image.largestRegion);
             s.timeouts += f.stats.queriesTimedOut;
         }
@@ -103,7 +109,8 @@ std::vector<ModeSummary> summarise(const BenchResult& r) {
         for (double v : ms) s.msMean += v;
         s.msMean /= n;
         for (double* v : {&s.traversalMs, &s.queryMs, &s.waitMs, &s.drawMs, &s.parts, &s.triangles, &s.queries, &s.occluded,
-                          &s.skippedHistory, &s.skippedOccupancy, &s.batches, &s.pctWrongMean, &s.falsePositives})
+                          &s.skippedHistory, &s.skippedOccupancy, &s.batches, &s.pctWrongMean, &s.falsePositives, &s.fpQueried,
+                          &s.fpHistory, &s.fpOccupancy, &s.fpOther, &s.drawQueries, &s.drawQueriesOccluded})
             *v /= n;
         std::sort(ms.begin(), ms.end());
         s.msMin = ms.front();
@@ -167,7 +174,9 @@ Status writeFramesCsv(const BenchResult& r, const fs::path& path) {
          "skipped_history,skipped_occupancy,visible_near,frustum_culled,small_feature_culled,nodes_visited,batches,"
          "parts,triangles,visible_parts,frustum_parts,false_negatives,false_negative_pixels,false_positives,"
          "pixels_wrong,pixels_wrong_pct,largest_wrong_region,frame_update_ms,ground_truth_ms,ground_truth_artefact_pixels,"
-         "draw_queries,draw_queries_occluded,draw_queries_late\n";
+         "draw_queries,draw_queries_occluded,draw_queries_late,false_positives_queried,false_positives_history,"
+         "false_positives_occupancy,false_positives_other,visible_triangles,bound_aabb_parts,bound_aabb_triangles,"
+         "bound_auto_parts,bound_auto_triangles\n";
     for (std::size_t i = 0; i < r.frames.size(); ++i) {
         const FrameTruth& t = r.truth[i];
         for (std::size_t m = 0; m < r.modes.size(); ++m) {
@@ -182,7 +191,14 @@ Status writeFramesCsv(const BenchResult& r, const fs::path& path) {
               << t.visibleParts << ',' << t.frustumParts << ',' << p.falseNegatives << ',' << p.falseNegativePixels
               << ',' << p.falsePositives << ',' << d.differingPixels << ',' << d.percentDiffering << ','
               << d.largestRegion << ',' << t.updateMs << ',' << t.groundTruthMs << ',' << t.artefactPixels << ','
-              << s.drawQueries << ',' << s.drawQueriesOccluded << ',' << s.drawQueriesLate << '\n';
+              << s.drawQueries << ',' << s.drawQueriesOccluded << ',' << s.drawQueriesLate << ',';
+            const FalsePositiveCauses& c = r.frames[i][m].falsePositiveCauses;
+            f << c.queried << ',' << c.history << ',' << c.occupancy << ',' << c.other << ',' << t.visibleTriangles;
+            if (t.boundMeasured)
+                f << ',' << t.boundAabb.parts << ',' << t.boundAabb.triangles << ',' << t.boundAuto.parts << ','
+                  << t.boundAuto.triangles << '\n';
+            else
+                f << ",,,,\n";  // not measured
         }
     }
     if (!f) return Error{path.string() + ": write failed"};
@@ -196,7 +212,8 @@ Status writeSummaryCsv(const std::vector<ModeSummary>& summary, const fs::path& 
          "triangles,queries,queries_occluded,skipped_history,skipped_occupancy,batches,pixels_wrong_pct_mean,"
          "pixels_wrong_pct_max,frames_wrong,false_negatives,false_negative_pixels,false_positives_per_frame,"
          "largest_wrong_region,timeouts,pareto,volume,pct_parts_culled,query_triangles,leaf_volume,"
-         "leaf_surface_area,leaf_triangles_mean,leaf_triangles_max,paired_vs_best\n";
+         "leaf_surface_area,leaf_triangles_mean,leaf_triangles_max,paired_vs_best,false_positives_queried,"
+         "false_positives_history,false_positives_occupancy,false_positives_other,draw_queries,draw_queries_occluded\n";
     for (const ModeSummary& s : summary)
         f << s.name << ',' << s.frames << ',' << s.msMean << ',' << s.msMedian << ',' << s.msMin << ',' << s.msMax
           << ',' << s.traversalMs << ',' << s.queryMs << ',' << s.waitMs << ',' << s.drawMs << ',' << s.ratioVfc << ',' << s.ratioOracle
@@ -206,7 +223,8 @@ Status writeSummaryCsv(const std::vector<ModeSummary>& summary, const fs::path& 
           << ',' << s.largestRegion << ',' << s.timeouts << ',' << (s.pareto ? 1 : 0) << ',' << s.volume << ','
           << s.pctPartsCulled << ',' << s.queryTriangles << ',' << s.leaves.volume << ',' << s.leaves.surfaceArea << ','
           << (s.leaves.leaves ? static_cast<double>(s.leaves.triangles) / static_cast<double>(s.leaves.leaves) : 0.0)
-          << ',' << s.leaves.maxTriangles << ',' << s.pairedVsBest << '\n';
+          << ',' << s.leaves.maxTriangles << ',' << s.pairedVsBest << ',' << s.fpQueried << ',' << s.fpHistory << ','
+          << s.fpOccupancy << ',' << s.fpOther << ',' << s.drawQueries << ',' << s.drawQueriesOccluded << '\n';
     if (!f) return Error{path.string() + ": write failed"};
     return {};
 }
@@ -346,6 +364,44 @@ void writeVolumeTable(std::ofstream& f, const std::vector<ModeSummary>& summary)
          "kind (auto picks per part).\n";
 }
 
+void writeFalsePositiveTable(std::ostream& f, const BenchResult& r, const std::vector<ModeSummary>& summary) {
+    double visibleTris = 0, aabbParts = 0, aabbTris = 0, autoParts = 0, autoTris = 0, visibleParts = 0;
+    std::size_t bounded = 0;
+    for (const FrameTruth& t : r.truth) {
+        if (!t.boundMeasured) continue;
+        ++bounded;
+        visibleParts += t.visibleParts;
+        visibleTris += static_cast<double>(t.visibleTriangles);
+        aabbParts += t.boundAabb.parts;
+        aabbTris += static_cast<double>(t.boundAabb.triangles);
+        autoParts += t.boundAuto.parts;
+        autoTris += static_cast<double>(t.boundAuto.triangles);
+    }
+    f << "\n## Where the false positives come from\n\n"
+      << "| mode | false pos./frame | query answered visible | history | occupancy accept | other untested | draw queries | of them drew nothing |\n"
+      << "|---|--:|--:|--:|--:|--:|--:|--:|\n";
+    for (const ModeSummary& s : summary) {
+        if (s.oracle) continue;
+        f << "| " << s.name << " | " << fmt(s.falsePositives, 1) << " | " << fmt(s.fpQueried, 1) << " | "
+          << fmt(s.fpHistory, 1) << " | " << fmt(s.fpOccupancy, 1) << " | " << fmt(s.fpOther, 1) << " | "
+          << fmt(s.drawQueries, 1) << " | " << fmt(s.drawQueriesOccluded, 1) << " |\n";
+    }
+    f << "\nPer frame: drawn parts with no visible pixel, by the decision that drew them (*other*: near plane, "
+         "front-most leaves, or vfc). *Draw queries*: parts drawn untested inside a query on their geometry; "
+         "*drew nothing*: answers read the next frame that found no sample (those parts are queried again).\n";
+    if (bounded == 0) return;
+    const double n = static_cast<double>(bounded);
+    f << "\n**Volume bound** (`--volume-bound`, " << bounded << " frames): parts whose query volume passes a query "
+      << "against the frame's final depth — what a conservative query-based mode with that volume draws at least, "
+      << "with perfect order and no history. Visible parts (the oracle): " << fmt(visibleParts / n, 1) << " per frame, "
+      << fmt(visibleTris / n, 0) << " triangles.\n\n"
+      << "| volume | parts/frame | triangles/frame | triangles vs oracle |\n|---|--:|--:|--:|\n"
+      << "| aabb (transformed local boxes) | " << fmt(aabbParts / n, 1) << " | " << fmt(aabbTris / n, 0) << " | "
+      << fmt(visibleTris > 0 ? aabbTris / visibleTris : 0.0, 3) << " |\n"
+      << "| auto (k-DOPs where they pay) | " << fmt(autoParts / n, 1) << " | " << fmt(autoTris / n, 0) << " | "
+      << fmt(visibleTris > 0 ? autoTris / visibleTris : 0.0, 3) << " |\n";
+}
+
 }  // namespace
 
 Status writeReport(const BenchResult& r, const std::vector<ModeSummary>& summary, const std::string& command,
@@ -388,6 +444,7 @@ Status writeReport(const BenchResult& r, const std::vector<ModeSummary>& summary
          "(ground truth) not drawn, summed over frames, with the pixels they own; false positives are drawn parts "
          "with no visible pixel; the largest wrong region is the biggest 4-connected blob of wrong pixels in any "
          "frame. `*` marks modes on the speed-accuracy Pareto front (the oracle is a bound, not a mode).\n";
+    writeFalsePositiveTable(f, r, summary);
     if (reportsVolumes(r)) writeVolumeTable(f, summary);
     if (!plots.empty()) {
         f << "\n## Plots\n\n";

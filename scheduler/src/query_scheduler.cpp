@@ -5,6 +5,7 @@
 #include "dyncull/scheduler/query_scheduler.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <chrono>
 #include <cmath>
 
@@ -262,14 +263,19 @@ QueryVolume QueryScheduler::queryVolume(NodeRef ref, const Aabb& worldBox) const
     // Tightened volume: the node's own object-space volume under the object's matrix
     // instead of its world AABB, once the object has kept its transform for a few frames.
     if (frame_ - stillSince_[ref.object] < params_.tightenAfterFrames) return QueryVolume::fromAabb(worldBox);
-    const SceneObjects& objs = tree_->objects();
+    return objectNodeVolume(tree_->objects(), ref, params_.volume, params_.autoVolumeSaving);
+}
+
+QueryVolume objectNodeVolume(const SceneObjects& objs, NodeRef ref, VolumeChoice volume, float autoSaving) {
+    assert(!ref.isSceneNode());
     const LocalBsp& model = objs.model(objs.modelOf(ref.object));
     const glm::mat4& m = objs.matrix(ref.object);
-    if (params_.volume == VolumeChoice::Aabb || model.volumes.nodeCount() != model.nodes.size())
+    if (volume == VolumeChoice::Aabb || model.volumes.nodeCount() != model.nodes.size())
         return QueryVolume::fromTransformedBox(m, model.nodes[ref.node].box);
-    const VolumeKind kind = chooseVolume(model.volumes, ref.node, params_.volume, params_.autoVolumeSaving);
+    const VolumeKind kind = chooseVolume(model.volumes, ref.node, volume, autoSaving);
     const NodeVolume& v = model.volumes.get(ref.node, kind);
-    if (v.vertexCount == 0) return QueryVolume::fromAabb(worldBox);  // empty node: never reached in practice
+    if (v.vertexCount == 0)  // empty node: never reached in practice
+        return QueryVolume::fromAabb(transformAabb(m, model.nodes[ref.node].box));
     return QueryVolume::fromNodeVolume(m, model.volumes, v);
 }
 

@@ -103,10 +103,11 @@ TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
     for (cli::ModeSpec& m : *modes) m.scheduler.queryTimeoutMs = 20000.0;
     auto runner = cli::BenchRunner::create(*engine, *scene, modes.take());
     ASSERT_TRUE(runner.ok()) << runner.error().message;
+    (*runner)->setMeasureVolumeBound(true);
     const auto& names = (*runner)->result().modes;
     ASSERT_EQ(names[0].name, "vfc");
 
-    std::uint64_t visibleSeen = 0, thresholdMisses = 0, occludedSeen = 0, queries = 0, drawQueriesOccluded = 0;
+    std::uint64_t visibleSeen = 0, thresholdMisses = 0, occludedSeen = 0, queries = 0, drawQueriesOccluded = 0, boundSlack = 0;
     double worstPercent = 0.0;
     for (std::uint64_t frame = 0; frame < bo.frames; ++frame) {
         ASSERT_TRUE((*runner)->runFrame(frame).ok());
@@ -114,6 +115,15 @@ TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
         const cli::FrameTruth& truth = (*runner)->result().truth.back();
         visibleSeen += truth.visibleParts;
         occludedSeen += truth.frustumParts - truth.visibleParts;
+        // A part whose volume is hidden behind the final depth has no visible pixel, so the
+        // volume bound holds every visible part; it is at most the parts in the frustum.
+        ASSERT_TRUE(truth.boundMeasured);
+        for (const cli::VolumeBound& b : {truth.boundAabb, truth.boundAuto}) {
+            EXPECT_GE(b.parts, truth.visibleParts);
+            EXPECT_LE(b.parts, truth.frustumParts);
+            EXPECT_GE(b.triangles, truth.visibleTriangles);
+        }
+        boundSlack += truth.boundAabb.parts - truth.visibleParts;
         for (std::size_t m = 0; m < row.size(); ++m) {
             if (names[m].oracle) {
                 EXPECT_EQ(row[m].parts.falsePositives, 0u);  // exactly the visible set
@@ -126,6 +136,9 @@ TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
             worstPercent = std::max(worstPercent, row[m].image.percentDiffering);
             queries += row[m].stats.queriesIssued;
             if (names[m].name == "full") drawQueriesOccluded += row[m].stats.drawQueriesOccluded;
+            // Every false positive has exactly one cause.
+            const cli::FalsePositiveCauses& c = row[m].falsePositiveCauses;
+            EXPECT_EQ(c.queried + c.history + c.occupancy + c.other, row[m].parts.falsePositives);
             EXPECT_LE(row[m].image.percentDiffering, 0.01);
             EXPECT_EQ(row[m].parts.falseNegatives, 0u);
             EXPECT_EQ(row[m].stats.queriesTimedOut, 0u);
@@ -140,6 +153,7 @@ TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
     EXPECT_GT(thresholdMisses, 0u) << "a 64-pixel threshold should drop some small visible parts";
     // Real GL draw queries answered, and some parts drawn untested turned out hidden.
     EXPECT_GT(drawQueriesOccluded, 0u);
+    EXPECT_GT(boundSlack, 0u) << "some hidden part should have a visible box";
     EXPECT_EQ(ctx->checkErrors(), 0u);
 }
 

@@ -649,10 +649,11 @@ TEST(QueryScheduler, DrawQueriesKeepVisiblePartsUnqueriedAndRequeryPartsThatDrew
             if (f >= 3) requeries += b.objectQueriesAt(-1.0f) + b.objectQueriesAt(0.0f) + b.objectQueriesAt(1.0f);
             if (f >= 3) EXPECT_EQ(st.drawQueries, drawQueries ? 3u : 0u);  // the three parts, skipped by history
         }
-        if (drawQueries)
+        if (drawQueries) {
             EXPECT_EQ(requeries, 0);
-        else
+        } else {
             EXPECT_GT(requeries, 0);
+        }
 
         // The left cube's geometry drew nothing last frame (answers are read at the start
         // of the next frame): with draw queries it is queried by box now, the others are
@@ -669,7 +670,9 @@ TEST(QueryScheduler, DrawQueriesKeepVisiblePartsUnqueriedAndRequeryPartsThatDrew
         b.drawRule = [](std::uint32_t) { return QueryResult::NotReady; };
         std::uint32_t late = 0;
         for (int f = 0; f < 12; ++f) late += frame().drawQueriesLate;
-        if (drawQueries) EXPECT_GT(late, 0u);
+        if (drawQueries) {
+            EXPECT_GT(late, 0u);
+        }
         b.drawRule = [](std::uint32_t) { return QueryResult::Visible; };
         p.mode = CullMode::Vfc;  // leaving Full releases the last frame's draw queries
         sched.setParams(p);

@@ -116,6 +116,12 @@ struct NodeTrace {
 /// Validates ranges (e.g. tile size > 0, maxQueriesInFlight > 0, autoVolumeSaving in [0, 1]).
 Status validateSchedulerParams(const SchedulerParams& p);
 
+/// The world-space volume Full queries object node `ref` with once tightened: the node's
+/// stored volume of kind chooseVolume(volume, autoSaving) — its local box for Aabb, or
+/// when the model has no volumes — under the object's current matrix. Its world AABB
+/// (`objects`' worldBox of the node) for a node with no stored vertices.
+QueryVolume objectNodeVolume(const SceneObjects& objects, NodeRef ref, VolumeChoice volume, float autoSaving);
+
 /// Runs one frame of culling and drawing. Owns the visibility history between frames;
 /// borrows the tree, backend and sink for the duration of cullFrame.
 class QueryScheduler {
