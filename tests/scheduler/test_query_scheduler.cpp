@@ -646,8 +646,9 @@ TEST(QueryScheduler, DrawQueriesKeepVisiblePartsUnqueriedAndRequeryPartsThatDrew
         int requeries = 0;
         for (int f = 0; f < 20; ++f) {
             const FrameStats st = frame();
-            if (f >= 3) requeries += b.objectQueriesAt(-1.0f) + b.objectQueriesAt(0.0f) + b.objectQueriesAt(1.0f);
-            if (f >= 3) EXPECT_EQ(st.drawQueries, drawQueries ? 3u : 0u);  // the three parts, skipped by history
+            if (f < 3) continue;
+            requeries += b.objectQueriesAt(-1.0f) + b.objectQueriesAt(0.0f) + b.objectQueriesAt(1.0f);
+            EXPECT_EQ(st.drawQueries, drawQueries ? 3u : 0u);  // the three parts, skipped by history
         }
         if (drawQueries) {
             EXPECT_EQ(requeries, 0);
