@@ -11,6 +11,8 @@
 #include <chrono>
 #include <cstdint>
 #include <cstring>
+#include <limits>
+#include <span>
 #include <string>
 #include <thread>
 
@@ -90,6 +92,8 @@ void GlQueryBackend::beginFrame(const Camera& camera, int, int) {
     // Camera-relative like the renderer: volumes are uploaded relative to the eye.
     viewProj_ = camera.viewProjectionRelative();
     eye_ = glm::dvec3(camera.position);
+    forward_ = glm::dvec3(camera.forward());
+    nearPlane_ = double(camera.nearPlane);
     // Orphan last frame's volumes so writing this frame's never waits on the rasteriser.
     // After a failed allocation both buffers are allocated again (either may have no storage).
     const bool retry = degraded_;
@@ -122,6 +126,15 @@ QueryId GlQueryBackend::acquireSlot() {
     queries_.emplace_back();
     glCreateQueries(GL_ANY_SAMPLES_PASSED_CONSERVATIVE, 1, &queries_[id].name);
     queries_[id].target = GL_ANY_SAMPLES_PASSED_CONSERVATIVE;
+    return id;
+}
+
+QueryId GlQueryBackend::answeredVisible() {
+    const QueryId id = acquireSlot();
+    Slot& s = queries_[id];
+    s.live = true;
+    s.result = QueryResult::Visible;
+    s.samples = 0;
     return id;
 }
 
@@ -186,9 +199,10 @@ QueryId GlQueryBackend::issue(const QueryVolume& volume) {
     assert(volume.vertexCount <= QueryVolume::kMaxVertices && volume.triangleCount <= QueryVolume::kMaxTriangles);
     assert(!volume.isBox() || volume.vertexCount == 8);
     const std::uint32_t nv = volume.vertexCount, ni = 3 * volume.triangleCount;
+    const std::uint32_t reserve = std::max(nv, 8u);  // a thin volume is drawn as an 8-corner box
     // Grow by doubling: earlier draws of this frame keep the orphaned storage they
     // referenced. On failure the capacity stays at the last size that worked.
-    if (!degraded_ && vboUsed_ + nv > vboCapacity_ &&
+    if (!degraded_ && vboUsed_ + reserve > vboCapacity_ &&
         allocate(vbo_, std::size_t{2} * vboCapacity_ * sizeof(glm::vec3), "growing the query volume vertex buffer")) {
         vboCapacity_ *= 2;
         vboUsed_ = 0;
@@ -198,21 +212,11 @@ QueryId GlQueryBackend::issue(const QueryVolume& volume) {
         iboCapacity_ *= 2;
         iboUsed_ = 0;
     }
-    if (degraded_) {
-        // No buffer to draw the volume from: answer Visible at once (never culls, never waits).
-        const QueryId id = acquireSlot();
-        Slot& s = queries_[id];
-        s.live = true;
-        s.result = QueryResult::Visible;
-        s.samples = 0;
-        return id;
-    }
-    // Vertices relative to the eye, each pushed away from the volume's centre by the float
-    // rounding its world coordinates may carry (2^-22 of the largest magnitude, i.e. 2 ulp):
-    // a volume 1e7 units from the origin is never smaller than the geometry it bounds, so
-    // the query stays conservative. On an axis where rounding collapsed a box flat (sign
-    // 0), the corner's index bit says which side it belongs to.
-    std::array<glm::vec3, QueryVolume::kMaxVertices> rel;
+    if (degraded_) return answeredVisible();  // no buffer to draw the volume from: never culls, never waits
+    // Vertices relative to the eye, the volume enlarged to cover the float rounding its
+    // world coordinates may carry: 2^-22 of the largest magnitude (2 ulp) per coordinate,
+    // so at most slack * sqrt(3) along any face normal. A volume 1e7 units from the origin
+    // is then never smaller than the geometry it bounds, and the query stays conservative.
     glm::dvec3 centre(0.0);
     double magnitude = 0.0;
     for (std::uint32_t i = 0; i < nv; ++i) {
@@ -220,26 +224,55 @@ QueryId GlQueryBackend::issue(const QueryVolume& volume) {
         centre += v / double(nv);
         magnitude = std::max({magnitude, std::abs(v.x), std::abs(v.y), std::abs(v.z)});
     }
-    const double slack = magnitude * 0x1p-22;
-    for (std::uint32_t i = 0; i < nv; ++i) {
-        const glm::dvec3 v(volume.vertices[i]);
-        glm::dvec3 out = glm::sign(v - centre);
-        if (volume.isBox())
-            for (int a = 0; a < 3; ++a)
-                if (out[a] == 0.0) out[a] = (i >> a) & 1u ? 1.0 : -1.0;
-        rel[i] = glm::vec3(v + out * slack - eye_);
+    const double slack = magnitude * 0x1p-22, push = slack * std::sqrt(3.0);
+    // Scaling about the centre moves every face out by (k - 1) times its distance from the
+    // centre and keeps its normal, so k = 1 + push / (nearest face distance) moves each
+    // face out by at least `push` (a per-axis push would slide tilted faces along themselves).
+    double nearest = std::numeric_limits<double>::infinity();
+    const std::span<const std::uint8_t> tris = volume.triangles();
+    for (std::size_t t = 0; t + 2 < tris.size(); t += 3) {
+        const glm::dvec3 a(volume.vertices[tris[t]]), b(volume.vertices[tris[t + 1]]), c(volume.vertices[tris[t + 2]]);
+        const glm::dvec3 n = glm::cross(b - a, c - a);
+        const double len = glm::length(n);
+        if (len > 0.0) nearest = std::min(nearest, std::abs(glm::dot(n, a - centre)) / len);  // zero-area: no face
     }
-    glNamedBufferSubData(vbo_, vboUsed_ * sizeof(glm::vec3), nv * sizeof(glm::vec3), rel.data());
-    if (!volume.isBox()) glNamedBufferSubData(meshIbo_, iboUsed_, ni, volume.indices.data());
-    if (boundMesh_ != !volume.isBox()) {
-        boundMesh_ = !volume.isBox();
+    std::array<glm::vec3, QueryVolume::kMaxVertices> rel;
+    // Thinner than a few roundings (e.g. collapsed flat by them): its vertices' axis-aligned
+    // box instead, each face pushed out along its axis; on an axis where the box is flat the
+    // corner's index bit says which side it belongs to.
+    const bool asBox = !(std::isfinite(nearest) && nearest > 4.0 * push);
+    if (asBox) {
+        glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+        for (std::uint32_t i = 0; i < nv; ++i) {
+            lo = glm::min(lo, glm::dvec3(volume.vertices[i]));
+            hi = glm::max(hi, glm::dvec3(volume.vertices[i]));
+        }
+        for (std::uint32_t i = 0; i < 8; ++i)
+            rel[i] = glm::vec3(glm::dvec3((i & 1u) ? hi.x + push : lo.x - push, (i & 2u) ? hi.y + push : lo.y - push,
+                                          (i & 4u) ? hi.z + push : lo.z - push) - eye_);
+    } else {
+        const double k = 1.0 + push / nearest;
+        for (std::uint32_t i = 0; i < nv; ++i) rel[i] = glm::vec3(centre + (glm::dvec3(volume.vertices[i]) - centre) * k - eye_);
+    }
+    const bool mesh = !asBox && !volume.isBox();
+    const std::uint32_t uploaded = asBox ? 8u : nv;
+    // The scheduler queries no box near the near plane (QueryScheduler::projectRect), but
+    // the enlargement may still carry a long volume across it: clipped there, it could
+    // answer "occluded" for visible geometry, so it answers Visible without being drawn.
+    for (std::uint32_t i = 0; i < uploaded; ++i) {
+        if (glm::dot(glm::dvec3(rel[i]), forward_) < nearPlane_) return answeredVisible();
+    }
+    glNamedBufferSubData(vbo_, vboUsed_ * sizeof(glm::vec3), uploaded * sizeof(glm::vec3), rel.data());
+    if (mesh) glNamedBufferSubData(meshIbo_, iboUsed_, ni, volume.indices.data());
+    if (boundMesh_ != mesh) {
+        boundMesh_ = mesh;
         glBindVertexArray(boundMesh_ ? meshVao_ : boxVao_);
     }
 
     const QueryId id = startQuery();
     const std::uint32_t target = queries_[id].target;
     glBeginQuery(target, queries_[id].name);
-    if (volume.isBox()) {
+    if (!mesh) {
         glDrawElementsBaseVertex(GL_TRIANGLES, 36, GL_UNSIGNED_BYTE, nullptr, static_cast<GLint>(vboUsed_));
     } else {
         glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(ni), GL_UNSIGNED_BYTE,
@@ -248,7 +281,7 @@ QueryId GlQueryBackend::issue(const QueryVolume& volume) {
         iboUsed_ += ni;
     }
     glEndQuery(target);
-    vboUsed_ += nv;
+    vboUsed_ += uploaded;
     return id;
 }
 

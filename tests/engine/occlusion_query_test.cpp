@@ -4,6 +4,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
 
+#include "dyncull/engine/gl_query_backend.hpp"
 #include "gl_test_util.hpp"
 #include "procedural_meshes.hpp"
 
@@ -45,6 +46,56 @@ TEST(OcclusionQuery, HiddenBoxZeroVisibleBoxOne) {
     r.endFrame();
 
     EXPECT_EQ(r.readPixels().at(32, 32), before) << "proxy boxes must not write colour";
+    EXPECT_EQ(ctx->checkErrors(), 0u);
+}
+
+/// A convex mesh volume: the octahedron with vertices centre +- half.x/y/z along the axes.
+QueryVolume octahedron(const glm::vec3& centre, const glm::vec3& half) {
+    QueryVolume v;
+    v.vertexCount = 6;
+    for (int a = 0; a < 3; ++a) {
+        glm::vec3 d(0.0f);
+        d[a] = half[a];
+        v.vertices[2 * a] = centre - d;
+        v.vertices[2 * a + 1] = centre + d;
+    }
+    // Faces: one vertex from each axis pair; winding is irrelevant (both sides drawn).
+    v.triangleCount = 8;
+    for (int f = 0; f < 8; ++f) {
+        v.indices[3 * f] = static_cast<std::uint8_t>(0 + ((f >> 0) & 1));
+        v.indices[3 * f + 1] = static_cast<std::uint8_t>(2 + ((f >> 1) & 1));
+        v.indices[3 * f + 2] = static_cast<std::uint8_t>(4 + ((f >> 2) & 1));
+    }
+    return v;
+}
+
+TEST(OcclusionQuery, BackendMeshVolumesAndVolumesReachingTheNearPlane) {
+    auto ctx = test::headless();
+    ASSERT_TRUE(ctx);
+    auto made = Renderer::create(*ctx);
+    ASSERT_TRUE(made.ok()) << made.error().message;
+    Renderer& r = **made;
+    auto backendOr = GlQueryBackend::create(*ctx);
+    ASSERT_TRUE(backendOr.ok()) << backendOr.error().message;
+    GlQueryBackend& b = **backendOr;
+    const Camera cam = test::cameraOnZ(3.0f);  // near plane at z = 2.9
+    const MeshId wall = *r.upload(test::quadMesh(5.0f));  // fills the whole view at z = 0
+    r.beginFrame(cam);
+    r.drawMesh(wall, glm::mat4(1.0f), {0.5f, 0.5f, 0.5f});
+    b.beginFrame(cam, test::kW, test::kH);
+    b.beginBatch();
+    const QueryId behind = b.issue(octahedron({0, 0, -1.0f}, glm::vec3(0.5f)));
+    const QueryId inFront = b.issue(octahedron({0, 0, 1.0f}, glm::vec3(0.5f)));
+    // Behind the wall but long enough to reach past the near plane: clipped there it
+    // might miss the samples in front of the wall, so it must answer Visible undrawn.
+    const QueryId throughNear = b.issue(octahedron({0, 0, 0.0f}, {0.1f, 0.1f, 2.95f}));
+    b.endBatch();
+    EXPECT_EQ(b.poll(throughNear), QueryResult::Visible);  // answered at once
+    EXPECT_EQ(b.samples(throughNear), 0u);
+    EXPECT_EQ(b.wait(behind, 10000.0), QueryResult::Occluded);
+    EXPECT_EQ(b.wait(inFront, 10000.0), QueryResult::Visible);
+    for (QueryId id : {behind, inFront, throughNear}) b.release(id);
+    r.endFrame();
     EXPECT_EQ(ctx->checkErrors(), 0u);
 }
 

@@ -60,6 +60,8 @@ private:
     QueryId acquireSlot();
     /// A free query object for the current threshold's target, marked live and unanswered.
     QueryId startQuery();
+    /// A query that is already answered Visible, drawing nothing.
+    QueryId answeredVisible();
     /// (Re)allocates a streaming buffer with glNamedBufferData; on failure records the
     /// error in frameStatus_ and enters the degraded state.
     bool allocate(std::uint32_t buffer, std::size_t bytes, const char* what);
@@ -84,6 +86,8 @@ private:
     bool boundMesh_ = false;         // meshVao_ (not boxVao_) bound in this batch
     glm::mat4 viewProj_{1.0f};       // camera-relative (Camera::viewProjectionRelative)
     glm::dvec3 eye_{0.0};            // world-space eye; volumes are uploaded relative to it
+    glm::dvec3 forward_{0.0, 0.0, -1.0};  // unit view direction (world space)
+    double nearPlane_ = 0.0;         // view distance of the near plane
     // State saved by beginBatch, restored by endBatch.
     int savedDepthFunc_ = 0;
     bool savedCull_ = false, savedDepthTest_ = false;

@@ -65,9 +65,9 @@ public:
     /// the volume shader) is switched once per batch rather than once per query.
     virtual void beginBatch() = 0;
     /// Draws `volume` depth-tested against what is drawn so far. A backend may draw it
-    /// enlarged by up to 2^-22 of its largest world coordinate per axis (GlQueryBackend
-    /// does, to cover float rounding far from the origin); the scheduler never queries a box
-    /// that could then reach the near plane (QueryScheduler::projectRect).
+    /// enlarged (GlQueryBackend does, to cover float rounding far from the origin); one that
+    /// would then reach the near plane must answer Visible without drawing. The scheduler
+    /// queries no box within 2^-21 of its coordinates of the near plane (QueryScheduler::projectRect).
     virtual QueryId issue(const QueryVolume& volume) = 0;
     virtual void endBatch() = 0;
     /// Non-blocking.
