@@ -59,7 +59,7 @@ void runRun(RunOptions o) {
     if (!size) fail(size.error().message);
     auto mode = parseCullMode(o.mode);
     if (!mode) fail("--mode: " + mode.error().message);
-    if (o.flags.volume != "aabb" && *mode != CullMode::Full) fail("--volume: applies to --mode full only");
+    if (o.flags.volume != SchedulerFlags{}.volume && *mode != CullMode::Full) fail("--volume: applies to --mode full only");
     auto made = makeScene(o.scene, o.sceneOptions);
     if (!made) fail(made.error().message);
     DemoScene& scene = **made;

@@ -319,7 +319,7 @@ PlotOutcome writePlots(const BenchResult& r, const std::vector<ModeSummary>& sum
 
 bool reportsVolumes(const BenchResult& r) {
     return std::any_of(r.modes.begin(), r.modes.end(),
-                       [](const ModeSpec& m) { return queriesNodeVolumes(m) && m.scheduler.volume != VolumeChoice::Aabb; });
+                       [](const ModeSpec& m) { return queriesNodeVolumes(m) && m.scheduler.volume != SchedulerParams{}.volume; });
 }
 
 namespace {

@@ -64,7 +64,7 @@ PlotOutcome writePlots(const BenchResult& result, const std::vector<ModeSummary>
                        const std::filesystem::path& dir);
 
 /// True when the report gets a query-volume table: some mode queries node volumes with a
-/// volume other than the default AABB (bench --volume/--volumes, or a MODE+VOLUME name).
+/// volume other than the default (auto) (bench --volume/--volumes, or a MODE+VOLUME name).
 bool reportsVolumes(const BenchResult& result);
 
 /// DIR/report.md. `command` is the command line shown at the top; `plots` the PNGs to embed.

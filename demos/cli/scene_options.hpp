@@ -31,7 +31,7 @@ struct SchedulerFlags {
     std::uint32_t maxSkip = SchedulerParams{}.history.maxSkipFrames;
     std::uint32_t pixelThreshold = 0;
     float frontPercent = 0.0f;
-    std::string volume = "aabb";  ///< one of aabb, obb, kdop14, kdop18, kdop26, auto (checked by CLI11)
+    std::string volume = "auto";  ///< one of aabb, obb, kdop14, kdop18, kdop26, auto (checked by CLI11)
     float autoSaving = SchedulerParams{}.autoVolumeSaving;
 };
 void addSchedulerOptions(CLI::App& cmd, SchedulerFlags& f);
