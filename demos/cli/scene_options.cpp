@@ -59,7 +59,9 @@ void addSchedulerOptions(CLI::App& cmd, SchedulerFlags& f) {
     cmd.add_flag("--no-history", f.noHistory, "full: do not skip queries of recently visible nodes");
     cmd.add_flag("--no-batching", f.noBatching, "full: one query in flight at a time");
     cmd.add_flag("--no-occupancy", f.noOccupancy, "full: no occupancy-map fast accept");
-    cmd.add_flag("--no-tight", f.noTight, "full: query world AABBs instead of tightened object boxes");
+    cmd.add_flag("--no-tight", f.noTight, "full: query world AABBs instead of tightened object volumes");
+    cmd.add_flag("--no-draw-queries", f.noDrawQueries,
+                 "full: no query on the geometry of parts drawn untested (visibility history alone decides)");
     cmd.add_option("--max-in-flight", f.maxInFlight, "full: maximum queries in flight")->capture_default_str();
     cmd.add_option("--max-skip", f.maxSkip, "full: maximum frames a visible node skips its query")->capture_default_str();
     cmd.add_option("--volume", f.volume, "full: query volume of object parts (auto picks per part)")
@@ -83,6 +85,7 @@ SchedulerParams toParams(const SchedulerFlags& f, CullMode mode) {
     p.useBatching = !f.noBatching;
     p.useOccupancyAccept = !f.noOccupancy;
     p.useTightVolumes = !f.noTight;
+    p.useDrawQueries = !f.noDrawQueries;
     p.maxQueriesInFlight = f.maxInFlight;
     p.history.maxSkipFrames = f.maxSkip;
     p.frontPercent = f.frontPercent;

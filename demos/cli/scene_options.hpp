@@ -26,7 +26,7 @@ void addMeasureOptions(CLI::App& cmd, MeasureOptions& o, std::string& size, cons
 
 /// Scheduler switches for `full` ablations and tuning.
 struct SchedulerFlags {
-    bool noHistory = false, noBatching = false, noOccupancy = false, noTight = false;
+    bool noHistory = false, noBatching = false, noOccupancy = false, noTight = false, noDrawQueries = false;
     std::uint32_t maxInFlight = SchedulerParams{}.maxQueriesInFlight;
     std::uint32_t maxSkip = SchedulerParams{}.history.maxSkipFrames;
     std::uint32_t pixelThreshold = 0;
