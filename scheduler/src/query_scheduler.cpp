@@ -419,50 +419,42 @@ void QueryScheduler::finishQuery(Pending& p, QueryResult r) {
         ++stats_->queriesOccluded;
 }
 
-void QueryScheduler::collectLatent(bool block) {
-    // Answers to queries of earlier frames (useLastFrameResults): recorded in the history
-    // for the next decision; never drawn from here.
-    for (std::size_t i = 0; i < latent_.size();) {
-        Pending& p = latent_[i];
-        QueryResult r = timedPoll(p.id);
-        if (r == QueryResult::NotReady && block) r = backend_->wait(p.id, params_.queryTimeoutMs);
-        if (r == QueryResult::NotReady) {
-            ++i;
-            continue;
-        }
-        backend_->release(p.id);
-        if (p.node.isSceneNode() || (p.node.object < tree_->objects().slotCount() && tree_->objects().alive(p.node.object))) {
-            NodeHistory& h = history_.at(p.node, tree_->objects());
-            h.queryInFlight = false;
-            history_.recordAnswer(h, r != QueryResult::Occluded, frame_);
-        }
-        latent_[i] = latent_.back();
-        latent_.pop_back();
-    }
-}
-
-void QueryScheduler::collectDrawAnswers() {
-    // Last frame's draw queries. A part already reached this frame keeps this frame's
-    // decision (the answer is older); an unanswered query is polled again later.
+template <class OnAnswer>
+void QueryScheduler::takeAnswered(std::vector<Pending>& queries, OnAnswer onAnswer) {
     const SceneObjects& objs = tree_->objects();
-    for (std::size_t i = 0; i < drawAnswers_.size();) {
-        const Pending& p = drawAnswers_[i];
+    for (std::size_t i = 0; i < queries.size();) {
+        const Pending p = queries[i];
         const QueryResult r = timedPoll(p.id);
         if (r == QueryResult::NotReady) {
             ++i;
             continue;
         }
         backend_->release(p.id);
-        if (p.node.object < objs.slotCount() && objs.alive(p.node.object)) {
-            NodeHistory& h = history_.at(p.node, objs);
-            if (h.lastTouchedFrame != frame_) {
-                history_.recordAnswer(h, r != QueryResult::Occluded, frame_ - 1);
-                if (r == QueryResult::Occluded) ++stats_->drawQueriesOccluded;
-            }
-        }
-        drawAnswers_[i] = drawAnswers_.back();
-        drawAnswers_.pop_back();
+        // The object may have been removed (or its slot reused) since the query was issued.
+        if (p.node.isSceneNode() || (p.node.object < objs.slotCount() && objs.alive(p.node.object)))
+            onAnswer(history_.at(p.node, objs), r);
+        queries[i] = queries.back();
+        queries.pop_back();
     }
+}
+
+void QueryScheduler::collectLatent() {
+    // Answers to queries of earlier frames (useLastFrameResults): recorded in the history
+    // for the next decision; never drawn from here.
+    takeAnswered(latent_, [&](NodeHistory& h, QueryResult r) {
+        h.queryInFlight = false;
+        history_.recordAnswer(h, r != QueryResult::Occluded, frame_);
+    });
+}
+
+void QueryScheduler::collectDrawAnswers() {
+    // Last frame's draw queries. A part already reached this frame keeps this frame's
+    // decision (the answer is older); an unanswered query is polled again later.
+    takeAnswered(drawAnswers_, [&](NodeHistory& h, QueryResult r) {
+        if (h.lastTouchedFrame == frame_) return;
+        history_.recordAnswer(h, r != QueryResult::Occluded, frame_ - 1);
+        if (r == QueryResult::Occluded) ++stats_->drawQueriesOccluded;
+    });
 }
 
 void QueryScheduler::runFull() {
@@ -546,7 +538,7 @@ void QueryScheduler::runFull() {
 
     waitingMap_.clear();
     bool answered = false;  // a query finished since waiting nodes were last retried
-    collectLatent(false);
+    collectLatent();
     // Last frame's draw queries become this frame's answers to read; never waited for.
     drawAnswers_.swap(drawQueries_);
     drawQueries_.clear();

@@ -64,8 +64,9 @@ struct SchedulerParams {
     /// transformed local box; Auto picks per node (chooseVolume in node_volumes.hpp).
     /// Scene nodes, Simple mode and untightened objects always use world AABBs; frustum
     /// tests, screen rectangles and the occupancy maps always use world AABBs. Auto by
-    /// default: measured never slower than the boxes and up to 15% faster on the bundled
-    /// scenes, with 10% fewer parts drawn on the bunnies (docs/BENCHMARKS.md).
+    /// default: it drew no more parts than the boxes on any bundled scene (11% fewer on the
+    /// bunny swarm, where it is 9% faster); the same mean time on the power plant, within
+    /// noise on the city and Sponza (docs/BENCHMARKS.md).
     VolumeChoice volume = VolumeChoice::Auto;
     /// Auto: a k-DOP replaces the node's best box only if it has at least this fraction
     /// less surface area (in [0, 1]). Chosen by measurement: see docs/BENCHMARKS.md.
@@ -203,7 +204,12 @@ private:
     void trace(NodeRef ref, const Aabb& box, NodeState s) {
         if (trace_) trace_->push_back({ref, box, s});
     }
-    void collectLatent(bool block);
+    /// Records the answers of latent_ that have arrived (non-blocking).
+    void collectLatent();
+    /// Polls `queries` (issued in earlier frames) without blocking: each answered one is
+    /// released and removed, and onAnswer(history, result) runs if its node still exists.
+    template <class OnAnswer>
+    void takeAnswered(std::vector<Pending>& queries, OnAnswer onAnswer);
 };
 
 }  // namespace dyncull
