@@ -79,6 +79,9 @@ Expected<std::unique_ptr<GlQueryBackend>> GlQueryBackend::create(GlContext& cont
 }
 
 GlQueryBackend::~GlQueryBackend() {
+    // Deleting a query drops its fence reference: first let every fence finish signalling
+    // (see free_ in the header).
+    glFinish();
     for (Slot& s : queries_) glDeleteQueries(1, &s.name);
     glDeleteVertexArrays(1, &boxVao_);
     glDeleteVertexArrays(1, &meshVao_);
@@ -117,9 +120,9 @@ bool GlQueryBackend::allocate(std::uint32_t buffer, std::size_t bytes, const cha
 }
 
 QueryId GlQueryBackend::acquireSlot() {
-    if (!free_.empty()) {
-        const QueryId id = free_.back();
-        free_.pop_back();
+    if (!free_.empty() && queries_[free_.front()].releaseMark < answeredSerial_) {
+        const QueryId id = free_.front();
+        free_.pop_front();
         return id;
     }
     const QueryId id = static_cast<QueryId>(queries_.size());
@@ -130,7 +133,14 @@ QueryId GlQueryBackend::acquireSlot() {
 }
 
 QueryId GlQueryBackend::answeredVisible() {
-    const QueryId id = acquireSlot();
+    // Never begun in GL, so any released slot will do (its query object stays untouched).
+    QueryId id;
+    if (!free_.empty()) {
+        id = free_.back();
+        free_.pop_back();
+    } else {
+        id = acquireSlot();
+    }
     Slot& s = queries_[id];
     s.live = true;
     s.result = QueryResult::Visible;
@@ -151,6 +161,7 @@ QueryId GlQueryBackend::startQuery() {
     s.live = true;
     s.result = QueryResult::NotReady;
     s.samples = 0;
+    s.begun = ++beginSerial_;  // every caller begins it in GL next
     return id;
 }
 
@@ -305,6 +316,7 @@ QueryResult GlQueryBackend::fetch(QueryId id) {
     GLuint available = 0;
     glGetQueryObjectuiv(s.name, GL_QUERY_RESULT_AVAILABLE, &available);
     if (!available) return QueryResult::NotReady;
+    answeredSerial_ = std::max(answeredSerial_, s.begun);
     GLuint64 value = 0;
     glGetQueryObjectui64v(s.name, GL_QUERY_RESULT, &value);
     s.samples = value;
@@ -330,6 +342,7 @@ QueryResult GlQueryBackend::wait(QueryId id, double timeoutMs) {
 void GlQueryBackend::release(QueryId id) {
     assert(queries_[id].live);
     queries_[id].live = false;
+    queries_[id].releaseMark = beginSerial_;
     free_.push_back(id);
 }
 

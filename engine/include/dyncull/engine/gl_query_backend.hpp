@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <deque>
 #include <vector>
 
 #include "dyncull/objects/error.hpp"
@@ -70,13 +71,25 @@ private:
         std::uint32_t name = 0;  // GL query object
         std::uint32_t target = 0;  // GL_ANY_SAMPLES_PASSED_CONSERVATIVE or GL_SAMPLES_PASSED
         std::uint64_t samples = 0;
+        std::uint64_t begun = 0;        // serial of its last glBeginQuery (0: never begun)
+        std::uint64_t releaseMark = 0;  // beginSerial_ when it was last released
         QueryResult result = QueryResult::NotReady;
         bool live = false;
     };
     GlContext& context_;
     GlQueryParams params_;
     std::vector<Slot> queries_;
-    std::vector<QueryId> free_;
+    // Released slots, oldest first. A slot's GL query object is begun again only once a
+    // query begun after its release has answered (answeredSerial_ > releaseMark). Mesa
+    // llvmpipe (22.3) frees a scene's fence when its last reference goes, and a reused
+    // query drops one, but it learns the fence is complete from a counter read without
+    // the fence's mutex while a rasteriser thread may still be signalling it: reusing the
+    // query at once let that thread write into freed memory (heap corruption). A query
+    // begun after the release lies in a later scene, so its answer proves every thread
+    // has left the earlier fence (docs/RELIABILITY.md, "Heap corruption in llvmpipe").
+    std::deque<QueryId> free_;
+    std::uint64_t beginSerial_ = 0;     // glBeginQuery calls so far
+    std::uint64_t answeredSerial_ = 0;  // largest `begun` of a query seen answered
     std::uint32_t program_ = 0, boxVao_ = 0, meshVao_ = 0, vbo_ = 0, boxIbo_ = 0, meshIbo_ = 0;
     int locViewProj_ = -1;
     std::uint32_t vboCapacity_ = 0;  // vertices
