@@ -1,6 +1,8 @@
 // CSV, Markdown and gnuplot outputs of bench and sweep (see report_writer.hpp).
 #include "report_writer.hpp"
 
+#include "dyncull/objects/checked_write.hpp"
+
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -50,12 +52,6 @@ std::string findOnPath(const std::string& name) {
         if (!ec && fs::is_regular_file(st) && (st.permissions() & fs::perms::others_exec) != fs::perms::none)
             return p.string();
     }
-    return {};
-}
-
-Status openFor(std::ofstream& f, const fs::path& path) {
-    f.open(path);
-    if (!f) return Error{path.string() + ": cannot write"};
     return {};
 }
 
@@ -169,7 +165,7 @@ std::vector<ModeSummary> summarise(const BenchResult& r) {
 
 Status writeFramesCsv(const BenchResult& r, const fs::path& path) {
     std::ofstream f;
-    if (Status s = openFor(f, path); !s) return s;
+    if (Status s = openChecked(f, path); !s) return s;
     f << "frame,mode,ms_frame,ms_traversal,ms_query,ms_wait,ms_draw,ms_update,queries,queries_occluded,queries_timed_out,"
          "skipped_history,skipped_occupancy,visible_near,frustum_culled,small_feature_culled,nodes_visited,batches,"
          "parts,triangles,visible_parts,frustum_parts,false_negatives,false_negative_pixels,false_positives,"
@@ -201,13 +197,12 @@ Status writeFramesCsv(const BenchResult& r, const fs::path& path) {
                 f << ",,,,\n";  // not measured
         }
     }
-    if (!f) return Error{path.string() + ": write failed"};
-    return {};
+    return closeChecked(f, path);
 }
 
 Status writeSummaryCsv(const std::vector<ModeSummary>& summary, const fs::path& path) {
     std::ofstream f;
-    if (Status s = openFor(f, path); !s) return s;
+    if (Status s = openChecked(f, path); !s) return s;
     f << "mode,frames,ms_mean,ms_median,ms_min,ms_max,ms_traversal,ms_query,ms_wait,ms_draw,ratio_vfc,ratio_oracle,parts,"
          "triangles,queries,queries_occluded,skipped_history,skipped_occupancy,batches,pixels_wrong_pct_mean,"
          "pixels_wrong_pct_max,frames_wrong,false_negatives,false_negative_pixels,false_positives_per_frame,"
@@ -225,8 +220,7 @@ Status writeSummaryCsv(const std::vector<ModeSummary>& summary, const fs::path& 
           << (s.leaves.leaves ? static_cast<double>(s.leaves.triangles) / static_cast<double>(s.leaves.leaves) : 0.0)
           << ',' << s.leaves.maxTriangles << ',' << s.pairedVsBest << ',' << s.fpQueried << ',' << s.fpHistory << ','
           << s.fpOccupancy << ',' << s.fpOther << ',' << s.drawQueries << ',' << s.drawQueriesOccluded << '\n';
-    if (!f) return Error{path.string() + ": write failed"};
-    return {};
+    return closeChecked(f, path);
 }
 
 PlotOutcome writePlots(const BenchResult& r, const std::vector<ModeSummary>& summary, const fs::path& dir) {
@@ -238,8 +232,14 @@ PlotOutcome writePlots(const BenchResult& r, const std::vector<ModeSummary>& sum
     }
     out.gnuplotFound = true;
     // Wide per-frame table: frame, then ms, parts, queries of each mode in turn.
+    // A plot file that cannot be written skips the plots with the reason; the report goes on.
+    auto skipped = [&out](const Status& s) {
+        out.message = s.message() + "; plots skipped";
+        return out;
+    };
     {
-        std::ofstream f(dir / "plot_frames.dat");
+        std::ofstream f;
+        if (Status s = openChecked(f, dir / "plot_frames.dat"); !s) return skipped(s);
         f << "# frame";
         for (const ModeSpec& m : r.modes) f << ' ' << m.name << "_ms " << m.name << "_parts " << m.name << "_queries";
         f << '\n';
@@ -249,29 +249,30 @@ PlotOutcome writePlots(const BenchResult& r, const std::vector<ModeSummary>& sum
                 f << ' ' << mf.stats.frameMs << ' ' << mf.stats.partsDrawn << ' ' << mf.stats.queriesIssued;
             f << '\n';
         }
-        if (!f) {
-            out.message = "cannot write plot data in " + dir.string() + ", plots skipped";
-            return out;
-        }
+        if (Status s = closeChecked(f, dir / "plot_frames.dat"); !s) return skipped(s);
     }
     {
-        std::ofstream f(dir / "plot_pareto.dat");
+        std::ofstream f, front;
+        if (Status s = openChecked(f, dir / "plot_pareto.dat"); !s) return skipped(s);
+        if (Status s = openChecked(front, dir / "plot_front.dat"); !s) return skipped(s);
         f << "# mode ms_mean pixels_wrong_pct_mean pareto\n";
         for (const ModeSummary& s : summary)
             f << '"' << s.name << "\" " << s.msMean << ' ' << s.pctWrongMean << ' ' << (s.pareto ? 1 : 0) << '\n';
-        std::ofstream front(dir / "plot_front.dat");
         std::vector<const ModeSummary*> pts;
         for (const ModeSummary& s : summary)
             if (s.pareto) pts.push_back(&s);
         std::sort(pts.begin(), pts.end(), [](auto* a, auto* b) { return a->msMean < b->msMean; });
         front << "# ms_mean pixels_wrong_pct_mean (Pareto front, by time)\n";
         for (auto* s : pts) front << s->msMean << ' ' << s->pctWrongMean << '\n';
+        if (Status s = closeChecked(f, dir / "plot_pareto.dat"); !s) return skipped(s);
+        if (Status s = closeChecked(front, dir / "plot_front.dat"); !s) return skipped(s);
     }
     std::string names;
     for (const ModeSpec& m : r.modes) names += (names.empty() ? "" : " ") + m.name;
     const std::string title = r.scene + ", " + std::to_string(r.width) + "x" + std::to_string(r.height) + ", " +
                               std::to_string(r.frames.size()) + " frames";
-    std::ofstream gp(dir / "plots.gp");
+    std::ofstream gp;
+    if (Status s = openChecked(gp, dir / "plots.gp"); !s) return skipped(s);
     gp << "# gnuplot script written by dyncull bench/sweep; run it in this directory.\n"
        << "if (strstrt(GPVAL_TERMINALS, 'pngcairo') > 0) {\n"
        << "  set terminal pngcairo size 1100,620 noenhanced font 'sans,10'\n"
@@ -304,7 +305,7 @@ PlotOutcome writePlots(const BenchResult& r, const std::vector<ModeSummary>& sum
        << "     " << gpQuote((dir / "plot_pareto.dat").string())
        << " using 2:(atleast($3)) with points pt 6 ps 1.4 lc rgb '#1f77b4' title 'mode / setting', \\\n"
        << "     '' using 2:(atleast($3)):1 with labels left offset 0.8,0.6 notitle\n";
-    gp.close();
+    if (Status s = closeChecked(gp, dir / "plots.gp"); !s) return skipped(s);
     const fs::path log = dir / "gnuplot.log";
     const std::string cmd = shellQuote(gnuplot) + " " + shellQuote((dir / "plots.gp").string()) + " > " +
                             shellQuote(log.string()) + " 2>&1";
@@ -407,7 +408,7 @@ void writeFalsePositiveTable(std::ostream& f, const BenchResult& r, const std::v
 Status writeReport(const BenchResult& r, const std::vector<ModeSummary>& summary, const std::string& command,
                    const std::vector<std::string>& plots, const fs::path& path) {
     std::ofstream f;
-    if (Status s = openFor(f, path); !s) return s;
+    if (Status s = openChecked(f, path); !s) return s;
     double visible = 0, frustum = 0, gtMs = 0, updateMs = 0;
     for (const FrameTruth& t : r.truth) {
         visible += t.visibleParts;
@@ -450,8 +451,7 @@ Status writeReport(const BenchResult& r, const std::vector<ModeSummary>& summary
         f << "\n## Plots\n\n";
         for (const std::string& p : plots) f << "![" << p << "](" << p << ")\n\n";
     }
-    if (!f) return Error{path.string() + ": write failed"};
-    return {};
+    return closeChecked(f, path);
 }
 
 }  // namespace dyncull::cli

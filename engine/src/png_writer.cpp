@@ -13,7 +13,12 @@
 #pragma GCC diagnostic pop
 #endif
 
+#include <cstdlib>
+#include <memory>
+#include <string_view>
+
 #include "dyncull/engine/image.hpp"
+#include "dyncull/objects/checked_write.hpp"
 
 namespace dyncull {
 
@@ -22,9 +27,13 @@ Status writePng(const Image& image, const std::filesystem::path& path) {
         image.rgba.size() != static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) * 4)
         return Error{path.string() + ": image is empty or its pixel buffer does not match " +
                      std::to_string(image.width) + "x" + std::to_string(image.height)};
-    if (!stbi_write_png(path.c_str(), image.width, image.height, 4, image.rgba.data(), image.width * 4))
-        return Error{path.string() + ": cannot write PNG (directory missing or not writable?)"};
-    return {};
+    // Encode in memory, then write with every write and the close checked: stb's own file
+    // path ignores fwrite and fclose failures, so a full disk would pass as written.
+    int size = 0;
+    std::unique_ptr<unsigned char, decltype(&std::free)> png(
+        stbi_write_png_to_mem(image.rgba.data(), image.width * 4, image.width, image.height, 4, &size), &std::free);
+    if (!png || size <= 0) return Error{path.string() + ": PNG encoding failed (out of memory?)"};
+    return writeFileChecked(path, std::string_view(reinterpret_cast<const char*>(png.get()), static_cast<std::size_t>(size)));
 }
 
 }  // namespace dyncull
