@@ -1,6 +1,7 @@
 #include "cli_util.hpp"
 
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <system_error>
 
@@ -39,6 +40,40 @@ Expected<glm::ivec2> parseSize(const std::string& text, const std::string& optio
     if (r1.ec != std::errc() || r1.ptr != b + x || r2.ec != std::errc() || r2.ptr != e) return bad;
     if (w < 1 || h < 1 || w > 16384 || h > 16384) return bad;
     return glm::ivec2(w, h);
+}
+
+CLI::Validator wholeIn(std::uint64_t lo, std::uint64_t hi) {
+    const std::string range = std::to_string(lo) + ".." + std::to_string(hi);
+    return CLI::Validator(
+        [lo, hi, range](std::string& text) -> std::string {
+            std::uint64_t v = 0;
+            const char* b = text.data();
+            const char* e = b + text.size();
+            const auto r = std::from_chars(b, e, v);
+            const bool digitsOnly = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
+            if (!digitsOnly || r.ec != std::errc() || r.ptr != e || v < lo || v > hi)
+                return "expected a whole number in " + range + ", got '" + text + "'";
+            return {};
+        },
+        "INT in " + range);
+}
+
+CLI::Validator realIn(double lo, double hi, bool lowOpen) {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "%c%g, %g]", lowOpen ? '(' : '[', lo, hi);
+    const std::string range = buf;
+    return CLI::Validator(
+        [lo, hi, lowOpen, range](std::string& text) -> std::string {
+            double v = 0;
+            const char* b = text.data();
+            const char* e = b + text.size();
+            const auto r = std::from_chars(b, e, v);
+            const bool inRange = std::isfinite(v) && (lowOpen ? v > lo : v >= lo) && v <= hi;
+            if (text.empty() || r.ec != std::errc() || r.ptr != e || !inRange)
+                return "expected a finite number in " + range + ", got '" + text + "'";
+            return {};
+        },
+        "NUM in " + range);
 }
 
 Status ensureParentDirectory(const std::filesystem::path& file) {

@@ -5,6 +5,9 @@
 #include <filesystem>
 #include <string>
 
+#include <cstdint>
+
+#include <CLI/CLI.hpp>
 #include <glm/glm.hpp>
 
 #include "dyncull/objects/error.hpp"
@@ -13,6 +16,15 @@ namespace dyncull::cli {
 
 /// Parses "WxH" (e.g. "1280x720"), each side in 1..16384. Error names the option.
 Expected<glm::ivec2> parseSize(const std::string& text, const std::string& optionName);
+
+/// Validators for every numeric option, so a bad value is refused with the flag's name
+/// before anything is allocated or run. CLI11 alone reads "-1" into an unsigned option as
+/// 2^64-1 and "nan" into a float option, and its Range passes NaN.
+/// A whole number in [lo, hi]: digits only (no sign, no fraction, no exponent).
+CLI::Validator wholeIn(std::uint64_t lo, std::uint64_t hi);
+/// A finite real number in [lo, hi], or in (lo, hi] with `lowOpen` (e.g. sizes that must
+/// be positive).
+CLI::Validator realIn(double lo, double hi, bool lowOpen = false);
 
 /// Creates the parent directory of `file` if needed. Error names the directory.
 Status ensureParentDirectory(const std::filesystem::path& file);

@@ -94,6 +94,7 @@ void registerBench(CLI::App& app) {
                     "(adds a query-volume table to report.md)");
     cmd->add_option("--auto-saving", o->autoSaving,
                     "auto volume: a k-DOP replaces a node's box if it saves at least this fraction of surface area")
+        ->check(realIn(0.0, 1.0))
         ->capture_default_str();
     addMeasureOptions(*cmd, o->measure, o->size, "out/bench_<scene>");
     cmd->callback([o] { runBench(*o); });

@@ -6,6 +6,7 @@
 
 #include "cli_util.hpp"
 #include "commands.hpp"
+#include "scene_options.hpp"
 #include "dyncull/bsp/local_bsp.hpp"
 #include "dyncull/objects/loaders.hpp"
 
@@ -64,10 +65,16 @@ void registerInspect(CLI::App& app) {
     auto o = std::make_shared<InspectOptions>();
     CLI::App* cmd = app.add_subcommand("inspect", "Build and describe the local BSP of every mesh in a file");
     cmd->add_option("file", o->file, "Scene file (.ply .obj .gltf .glb)")->required();
-    cmd->add_option("--max-leaf-tris", o->maxLeafTriangles, "Stop splitting at this many triangles")->capture_default_str();
-    cmd->add_option("--max-depth", o->maxDepth, "Maximum tree depth")->capture_default_str();
+    cmd->add_option("--max-leaf-tris", o->maxLeafTriangles, "Stop splitting at this many triangles")
+        ->check(wholeIn(1, kMaxTriangleCount))
+        ->capture_default_str();
+    cmd->add_option("--max-depth", o->maxDepth, "Maximum tree depth")
+        ->check(wholeIn(1, kLocalBspMaxDepth))
+        ->capture_default_str();
     cmd->add_option("--method", o->method, "Split plane: median (spatial median, the paper's) or sah")->capture_default_str();
-    cmd->add_option("--nudge", o->nudge, "Plane nudge window as a fraction of the node extent")->capture_default_str();
+    cmd->add_option("--nudge", o->nudge, "Plane nudge window as a fraction of the node extent")
+        ->check(realIn(0.0, 0.5))
+        ->capture_default_str();
     cmd->callback([o] { runInspect(*o); });
 }
 

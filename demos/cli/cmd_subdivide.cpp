@@ -9,6 +9,8 @@
 #include <memory>
 #include <string>
 
+#include <limits>
+
 #include "cli_util.hpp"
 #include "commands.hpp"
 #include "dyncull/bsp/subdivision_file.hpp"
@@ -104,18 +106,32 @@ void registerSubdivide(CLI::App& app) {
     cmd->add_option("--out", o->out, "output file (.dsub), read by `dyncull run/bench FILE`")->required();
     SubdivideOptions& s = o->sceneOptions.subdivide;
     cmd->add_option("--method", s.method, "phbvo, dbvs, octree (load-balanced) or grid (regular octree)")->capture_default_str();
-    cmd->add_option("--max-tris", s.maxTriangles, "maximum triangles per leaf (object)")->capture_default_str();
-    cmd->add_option("--max-depth", s.maxDepth, "maximum subdivision depth")->capture_default_str();
-    cmd->add_option("--collapse", s.collapseTo, "collapse to at most this many children per node (4: quad tree; 0 keeps the tree)")
+    cmd->add_option("--max-tris", s.maxTriangles, "maximum triangles per leaf (object)")
+        ->check(wholeIn(1, kMaxTriangleCount))
         ->capture_default_str();
-    cmd->add_option("--threads", s.threads, "worker threads (the result does not depend on it)")->capture_default_str();
-    cmd->add_option("--plant-seed", o->sceneOptions.plant.seed, "powerplant: generator seed")->capture_default_str();
-    cmd->add_option("--plant-size", o->sceneOptions.plant.size, "powerplant: fraction of the objects, (0, 1]")->capture_default_str();
-    cmd->add_option("--plant-detail", o->sceneOptions.plant.detail, "powerplant: tessellation factor, (0, 1]")->capture_default_str();
-    cmd->add_option("--city-seed", o->sceneOptions.city.seed, "city: generator seed")->capture_default_str();
+    cmd->add_option("--max-depth", s.maxDepth, "maximum subdivision depth")->check(wholeIn(1, kSubdivisionMaxDepth))->capture_default_str();
+    cmd->add_option("--collapse", s.collapseTo, "collapse to at most this many children per node (4: quad tree; 0 keeps the tree)")
+        ->check(wholeIn(0, 1000000))
+        ->capture_default_str();
+    cmd->add_option("--threads", s.threads, "worker threads (the result does not depend on it)")
+        ->check(wholeIn(1, kMaxThreads))
+        ->capture_default_str();
+    cmd->add_option("--plant-seed", o->sceneOptions.plant.seed, "powerplant: generator seed")
+        ->check(wholeIn(0, std::numeric_limits<std::uint64_t>::max()))
+        ->capture_default_str();
+    cmd->add_option("--plant-size", o->sceneOptions.plant.size, "powerplant: fraction of the objects, (0, 1]")
+        ->check(realIn(0.0, 1.0, true))
+        ->capture_default_str();
+    cmd->add_option("--plant-detail", o->sceneOptions.plant.detail, "powerplant: tessellation factor, (0, 1]")
+        ->check(realIn(0.0, 1.0, true))
+        ->capture_default_str();
+    cmd->add_option("--city-seed", o->sceneOptions.city.seed, "city: generator seed")
+        ->check(wholeIn(0, std::numeric_limits<std::uint64_t>::max()))
+        ->capture_default_str();
     cmd->add_option_function<std::uint32_t>(
         "--city-blocks", [o](const std::uint32_t& n) { o->sceneOptions.city.blocksX = o->sceneOptions.city.blocksZ = n; },
-        "city: blocks along each axis (default 20)");
+        "city: blocks along each axis (default 20, at most 100)")
+        ->check(wholeIn(1, 100));
     cmd->callback([o] { runSubdivide(*o); });
 }
 

@@ -1,11 +1,13 @@
 // `dyncull view FILE`: load a scene, frame it, render one lit frame (headless by default)
 // and write a PNG, reporting what was loaded and how long each step took.
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <string>
 
 #include "cli_util.hpp"
 #include "commands.hpp"
+#include "scene_options.hpp"
 #include "dyncull/engine/gl_context.hpp"
 #include "dyncull/engine/image.hpp"
 #include "dyncull/engine/renderer.hpp"
@@ -32,6 +34,17 @@ void drawScene(Renderer& renderer, const Scene& scene, const std::vector<MeshId>
         renderer.drawMesh(ids[inst.mesh], inst.transform, colourForId(static_cast<std::uint32_t>(i)));
     }
     renderer.endFrame();
+}
+
+// True if every pixel has the renderer's clear colour.
+bool isBlank(const Image& image) {
+    const glm::u8vec4 clear(glm::round(Renderer::kClearColour * 255.0f), 255);
+    for (std::size_t i = 0; i + 3 < image.rgba.size(); i += 4) {
+        // One unit of tolerance per channel: the clear colour's float-to-8-bit rounding.
+        for (int c = 0; c < 3; ++c)
+            if (std::abs(int(image.rgba[i + c]) - int(clear[c])) > 1) return false;
+    }
+    return true;
 }
 
 void runView(const ViewOptions& o) {
@@ -74,6 +87,7 @@ void runView(const ViewOptions& o) {
     const double uploadMs = sw.lap();
 
     const Aabb bounds = scene.worldBounds();
+    if (Status s = checkFramable(bounds); !s) fail(o.file + ": cannot make a picture: " + s.message());
     Camera camera = Camera::framing(bounds, static_cast<float>(ctx.size().x) / static_cast<float>(ctx.size().y));
     drawScene(renderer, scene, ids, camera);
     renderer.finish();
@@ -81,6 +95,10 @@ void runView(const ViewOptions& o) {
 
     const Image image = renderer.readPixels();
     const double readbackMs = sw.lap();
+    // A model with triangles that covers no pixel is a failure, not a picture.
+    if (scene.instancedTriangleCount() > 0 && isBlank(image))
+        fail(o.file + ": the picture is blank: " + std::to_string(scene.instancedTriangleCount()) +
+             " triangles drew no pixel (degenerate, or too thin to cover a pixel centre); nothing written");
 
     const Status dir = ensureParentDirectory(o.screenshot);
     if (!dir) fail(dir.message());
@@ -116,7 +134,8 @@ void registerView(CLI::App& app) {
     cmd->add_option("--size", opts->size, "Image size WxH in pixels")->capture_default_str();
     cmd->add_option("--screenshot", opts->screenshot, "PNG to write (directories are created)")->capture_default_str();
     cmd->add_flag("--window", opts->window, "Show a GLFW window instead of rendering headless");
-    cmd->add_option("--frames", opts->frames, "With --window: stop after N frames (0 = until closed)");
+    cmd->add_option("--frames", opts->frames, "With --window: stop after N frames (0 = until closed)")
+        ->check(wholeIn(0, kMaxFrames));
     cmd->add_flag("--debug", opts->debug, "Debug GL context: report GL errors via KHR_debug");
     cmd->callback([opts] { runView(*opts); });
 }

@@ -7,10 +7,20 @@
 #include <CLI/CLI.hpp>
 
 #include "bench_runner.hpp"
+#include "cli_util.hpp"
 #include "dyncull/demos/demo_scene.hpp"
 #include "dyncull/scheduler/query_scheduler.hpp"
 
 namespace dyncull::cli {
+
+/// Upper limits of the numeric options, stated in --help and enforced before anything is
+/// allocated: far beyond any sensible run, small enough that a typo cannot ask for
+/// terabytes or run for years.
+inline constexpr std::uint64_t kMaxFrames = 10'000'000;        ///< a day of 10 ms frames
+inline constexpr std::uint64_t kMaxBunnies = 100'000;          ///< ~350 bytes of scene state each
+inline constexpr std::uint64_t kMaxTriangleCount = 100'000'000;  ///< per leaf limits
+inline constexpr std::uint64_t kMaxThreads = 256;
+
 
 /// Adds --count --box --bunny-size --speed --seed --orbit --mesh --assets --path-frames.
 void addBunnyOptions(CLI::App& cmd, BunnySwarmOptions& o);

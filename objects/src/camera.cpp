@@ -1,6 +1,8 @@
 #include "dyncull/objects/camera.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -61,6 +63,35 @@ Camera Camera::framing(const Aabb& box, float aspectRatio, const glm::vec3& dir)
     c.nearPlane = std::max(dist - radius * 1.5f, dist * 1e-3f);
     c.farPlane = dist + radius * 1.5f;
     return c;
+}
+
+Status checkFramable(const Aabb& b) {
+    if (b.empty()) return Error{"the model has no vertices to frame"};
+    const glm::vec3 lo = b.min, hi = b.max;
+    for (int i = 0; i < 3; ++i)
+        if (!std::isfinite(lo[i]) || !std::isfinite(hi[i])) return Error{"the model's bounds are not finite"};
+    // The framing camera sits about 2.2 radii from the centre with its far plane 3.7 radii
+    // out: 1e36 leaves a factor of 300 before float overflows at 3.4e38.
+    constexpr double kLimit = 1e36;
+    double size = 0.0, reach = 0.0;
+    for (int i = 0; i < 3; ++i) {
+        size = std::max(size, static_cast<double>(hi[i]) - static_cast<double>(lo[i]));
+        reach = std::max({reach, std::abs(static_cast<double>(lo[i])), std::abs(static_cast<double>(hi[i]))});
+    }
+    char buf[160];
+    if (size == 0.0) return Error{"the model has zero size (all its vertices are at one point): nothing to frame"};
+    if (reach >= kLimit || size >= kLimit) {
+        std::snprintf(buf, sizeof buf, "the model reaches %.3g units from the origin (size %.3g): a single-precision "
+                      "camera cannot frame beyond 1e36", reach, size);
+        return Error{buf};
+    }
+    // 64 ulps: float spacing at `reach` is reach * 2^-23.
+    if (size < 64.0 * reach * 0x1p-23) {
+        std::snprintf(buf, sizeof buf, "the model is %.3g units across at %.3g from the origin: below 64 float ulps, "
+                      "its vertices cannot be told apart in single precision", size, reach);
+        return Error{buf};
+    }
+    return {};
 }
 
 Status validateCamera(const Camera& c) {

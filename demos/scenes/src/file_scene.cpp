@@ -52,6 +52,8 @@ public:
         auto scene = loadScene(path_);
         if (!scene) return Error{scene.error().message};
         std::vector<ModelId> models;
+        // Before anything reaches the engine: a model no camera can frame is bad input.
+        if (Status s = checkFramable(scene->worldBounds()); !s) return Error{path_ + ": cannot frame the model: " + s.message()};
         std::size_t after = 0;
         for (const Mesh& m : scene->meshes) {
             auto id = engine.addModel(m);

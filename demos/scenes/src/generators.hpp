@@ -7,7 +7,7 @@
 
 #include "dyncull/demos/demo_scene.hpp"
 #include "prepared_scene.hpp"
-#include "progress_bar.hpp"
+#include "dyncull/demos/progress_bar.hpp"
 
 namespace dyncull {
 

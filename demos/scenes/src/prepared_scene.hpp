@@ -13,7 +13,7 @@
 #include "dyncull/demos/demo_scene.hpp"
 #include "dyncull/objects/mesh.hpp"
 #include "dyncull/objects/transform.hpp"
-#include "progress_bar.hpp"
+#include "dyncull/demos/progress_bar.hpp"
 
 namespace dyncull {
 

@@ -1,6 +1,7 @@
-#include "progress_bar.hpp"
+#include "dyncull/demos/progress_bar.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <unistd.h>
 
 namespace dyncull {
@@ -18,6 +19,13 @@ void ProgressBar::advance(double amount) {
     draw(false);
 }
 
+void ProgressBar::advance(double amount, std::string note) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    note_ = std::move(note);
+    done_ = std::min(total_, done_ + amount);
+    draw(false);
+}
+
 void ProgressBar::restart(std::string label, double total) {
     std::lock_guard<std::mutex> lock(mutex_);
     if (!finished_) {
@@ -26,6 +34,7 @@ void ProgressBar::restart(std::string label, double total) {
         if (tty_ && out_) std::fputc('\n', out_);
     }
     label_ = std::move(label);
+    note_.clear();
     total_ = std::max(total, 1e-9);
     done_ = 0.0;
     finished_ = false;
@@ -36,8 +45,18 @@ void ProgressBar::restart(std::string label, double total) {
 void ProgressBar::finish() {
     std::lock_guard<std::mutex> lock(mutex_);
     if (finished_) return;
-    done_ = total_;
-    draw(true);
+    // The last advance may have drawn the finished state already: do not repeat it.
+    if (done_ < total_ || lastDrawnDone_ < total_) {
+        done_ = total_;
+        draw(true);
+    }
+    if (tty_ && out_) std::fputc('\n', out_);
+    finished_ = true;
+}
+
+void ProgressBar::cancel() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (finished_) return;
     if (tty_ && out_) std::fputc('\n', out_);
     finished_ = true;
 }
@@ -49,19 +68,24 @@ void ProgressBar::draw(bool force) {
     // A TTY redraws ten times a second; a log gets a line every 5 s at most.
     if (!force && sinceDraw < (tty_ ? 0.1 : 5.0)) return;
     lastDraw_ = now;
+    lastDrawnDone_ = done_;
     const double elapsed = std::chrono::duration<double>(now - start_).count();
     const double frac = std::clamp(done_ / total_, 0.0, 1.0);
     const double eta = frac > 1e-3 ? elapsed * (1.0 - frac) / frac : 0.0;
-    char tail[64];
+    char tail[96];
     if (frac >= 1.0) std::snprintf(tail, sizeof tail, "done in %.1f s", elapsed);
     else if (frac > 1e-3) std::snprintf(tail, sizeof tail, "ETA %.0f s", eta);
     else std::snprintf(tail, sizeof tail, "ETA --");
+    if (!note_.empty()) {
+        const std::size_t used = std::strlen(tail);
+        std::snprintf(tail + used, sizeof tail - used, "  %s", note_.c_str());
+    }
     if (tty_) {
         constexpr int kWidth = 30;
         const int filled = static_cast<int>(frac * kWidth);
         std::string bar(static_cast<std::size_t>(filled), '#');
         bar.resize(kWidth, '.');
-        std::fprintf(out_, "\r%-28s [%s] %3.0f%%  %-20s", label_.c_str(), bar.c_str(), 100.0 * frac, tail);
+        std::fprintf(out_, "\r%-28s [%s] %3.0f%%  %-40s", label_.c_str(), bar.c_str(), 100.0 * frac, tail);
     } else {
         std::fprintf(out_, "%s: %.0f%% %s\n", label_.c_str(), 100.0 * frac, tail);
     }

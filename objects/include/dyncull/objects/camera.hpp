@@ -66,6 +66,14 @@ glm::dmat4 reversedZPerspective(double fovY, double aspect, double nearPlane, do
 /// Rejects NaN/Inf, near <= 0, far <= near, degenerate up/target, fov outside (0, pi).
 Status validateCamera(const Camera& camera);
 
+/// Whether Camera::framing can show `worldBounds` (world units) as a picture: the box must be
+/// non-empty and finite, have a non-zero size, keep the framing camera's position and far
+/// plane finite in single precision (every coordinate and the size below 1e36), and be at
+/// least 64 float ulps of its distance from the origin across (else its vertices and the
+/// camera collapse onto a few representable positions). The error says which, without a
+/// file name: the caller prefixes it.
+Status checkFramable(const Aabb& worldBounds);
+
 /// Six planes (left, right, bottom, top, near, far) with inward normals: a point p is
 /// inside when dot(n, p) + d >= 0 for all planes. Extracted from a view-projection matrix
 /// in this file's reversed-Z convention (near: z <= w, far: z >= 0).

@@ -20,17 +20,23 @@ public:
 
     /// Adds `amount` units of work done (any thread).
     void advance(double amount);
+    /// Adds `amount` and sets a short note shown after the ETA (e.g. "2495 ms/frame").
+    void advance(double amount, std::string note);
     /// Starts a new phase: new label and total, progress back to zero, same stream.
     void restart(std::string label, double total);
     /// Prints the final state once (also done by the destructor).
     void finish();
+    /// Ends the bar where it stands, for work stopped early (no "done" line).
+    void cancel();
 
 private:
     void draw(bool force);  // mutex held
 
     std::mutex mutex_;
     std::string label_;
+    std::string note_;
     double total_, done_ = 0.0;
+    double lastDrawnDone_ = -1.0;  // done_ when last drawn
     std::FILE* out_;
     bool tty_;
     bool finished_ = false;
