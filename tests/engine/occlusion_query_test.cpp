@@ -99,5 +99,62 @@ TEST(OcclusionQuery, BackendMeshVolumesAndVolumesReachingTheNearPlane) {
     EXPECT_EQ(ctx->checkErrors(), 0u);
 }
 
+// A released query object is begun again only after a query begun after its release has
+// answered: Mesa llvmpipe may still be signalling the fence the object holds when the
+// answer first shows (docs/RELIABILITY.md, "Heap corruption in llvmpipe").
+TEST(OcclusionQuery, ReleasedQueryObjectWaitsForALaterAnswerBeforeReuse) {
+    auto ctx = test::headless();
+    ASSERT_TRUE(ctx);
+    auto made = Renderer::create(*ctx);
+    ASSERT_TRUE(made.ok()) << made.error().message;
+    Renderer& r = **made;
+    auto backendOr = GlQueryBackend::create(*ctx);
+    ASSERT_TRUE(backendOr.ok()) << backendOr.error().message;
+    GlQueryBackend& b = **backendOr;
+    const Camera cam = test::cameraOnZ(3.0f);
+    r.beginFrame(cam);  // binds and clears the framebuffer: every volume is visible
+    auto stopAndWait = [&] {  // Simple OC's pattern: issue, wait, release
+        b.beginBatch();
+        const QueryId q = b.issue(octahedron({0, 0, 0.0f}, glm::vec3(0.5f)));
+        b.endBatch();
+        EXPECT_EQ(b.wait(q, 10000.0), QueryResult::Visible);
+        b.release(q);
+        return q;
+    };
+    b.beginFrame(cam, test::kW, test::kH);
+    const QueryId first = stopAndWait();
+    EXPECT_EQ(b.poolSize(), 1u);
+    // `first` was released, but no query begun since has answered: a second object.
+    const QueryId second = stopAndWait();
+    EXPECT_NE(second, first);
+    EXPECT_EQ(b.poolSize(), 2u);
+    // `second` answered after `first`'s release: `first` is reused, and so on, round robin.
+    for (int i = 0; i < 10; ++i) {
+        const QueryId q = stopAndWait();
+        EXPECT_EQ(q, i % 2 == 0 ? first : second) << "round " << i;
+    }
+    EXPECT_EQ(b.poolSize(), 2u);
+    EXPECT_EQ(b.inUse(), 0u);
+    // Queries released unanswered do not count as answers for each other.
+    b.beginBatch();
+    const QueryId a = b.issue(octahedron({0, 0, 0.0f}, glm::vec3(0.5f)));
+    const QueryId c = b.issue(octahedron({0, 0, 0.0f}, glm::vec3(0.5f)));
+    b.endBatch();
+    b.release(a);
+    b.release(c);
+    b.beginBatch();
+    const QueryId d = b.issue(octahedron({0, 0, 0.0f}, glm::vec3(0.5f)));
+    b.endBatch();
+    EXPECT_NE(d, a);
+    EXPECT_NE(d, c);
+    // a took the older loop object; c and d each needed a new one (the newer loop object
+    // waits for an answer begun after its release).
+    EXPECT_EQ(b.poolSize(), 4u);
+    EXPECT_EQ(b.wait(d, 10000.0), QueryResult::Visible);
+    b.release(d);
+    r.endFrame();
+    EXPECT_EQ(ctx->checkErrors(), 0u);
+}
+
 }  // namespace
 }  // namespace dyncull
