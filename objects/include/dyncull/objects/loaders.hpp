@@ -1,4 +1,4 @@
-// Scene loading from files: PLY (own parser), Wavefront OBJ (tinyobjloader) and
+// Scene loading from files: PLY and Wavefront OBJ (own parsers) and
 // glTF 2.0 (tinygltf). Every loader returns either a complete Scene or an Error whose
 // one-line message starts with the file path and names the problem; it never returns a
 // half-filled Scene. Every returned mesh has passed validateMesh(), is an indexed
@@ -27,6 +27,10 @@ Expected<Scene> loadPly(const std::filesystem::path& path);
 /// Wavefront OBJ. One mesh (and one identity instance) per OBJ shape (o/g group) that
 /// has faces; vertices are deduplicated per mesh by (position, normal) index pair.
 /// Materials and texture coordinates are ignored; a missing .mtl file is not an error.
+/// Every number must parse and be finite, every index must name an element defined
+/// earlier in the file, and a face needs 3 corners; otherwise the Error names the line.
+/// Polygons are ear-clipped: zero-area ones are dropped, self-intersecting ones get
+/// best-effort triangles.
 Expected<Scene> loadObj(const std::filesystem::path& path);
 
 /// glTF 2.0, .gltf (external or base64 buffers) or .glb. Walks the default scene (or
