@@ -2,7 +2,7 @@
 // glTF 2.0 (tinygltf). Every loader returns either a complete Scene or an Error whose
 // one-line message starts with the file path and names the problem; it never returns a
 // half-filled Scene. Every returned mesh has passed validateMesh(), is an indexed
-// triangle list (polygons fan-triangulated) and has unit normals (from the file when
+// triangle list (polygons ear-clipped) and has unit normals (from the file when
 // present and valid, otherwise computeNormals()).
 #pragma once
 
@@ -20,8 +20,10 @@ Expected<Scene> loadScene(const std::filesystem::path& path);
 /// PLY in ascii, binary_little_endian or binary_big_endian. Needs a `vertex` element
 /// with x, y, z and a `face` element with a `vertex_indices` (or `vertex_index`) list;
 /// other elements and properties (confidence, intensity, flags, ...) are skipped.
-/// Optional nx, ny, nz vertex properties are used as normals. Faces with fewer than 3
-/// vertices are dropped. Result: one mesh, one identity instance; units as in the file.
+/// Optional nx, ny, nz vertex properties are used as normals. Polygons are ear-clipped;
+/// faces with fewer than 3 vertices and zero-area polygons are dropped. Arrays grow as
+/// data is read, never from header counts. Result: one mesh, one identity instance;
+/// units as in the file.
 Expected<Scene> loadPly(const std::filesystem::path& path);
 
 /// Wavefront OBJ. One mesh (and one identity instance) per OBJ shape (o/g group) that
