@@ -331,11 +331,12 @@ std::optional<Fail> addFace(PlyData& d, const std::int64_t* idx, std::size_t n, 
             return Fail{where() + ": vertex index " + std::to_string(idx[k]) + " out of range (" +
                         std::to_string(vertexCount) + " vertices)"};
     if (n < 3) return std::nullopt;
+    if (n > 0xFFFFFFFFu) return Fail{where() + ": face with more than 2^32 - 1 corners"};  // ASCII list counts are 64-bit
     d.face.clear();
     for (std::size_t k = 0; k < n; ++k) d.face.push_back(static_cast<std::uint32_t>(idx[k]));  // < vertexCount < 2^32
     if (d.positions.size() < vertexCount) {
         d.deferredCorners.insert(d.deferredCorners.end(), d.face.begin(), d.face.end());
-        d.deferredSizes.push_back(static_cast<std::uint32_t>(n));  // n <= 2^32 - 1: list counts are at most 32-bit
+        d.deferredSizes.push_back(static_cast<std::uint32_t>(n));
         return std::nullopt;
     }
     if (auto f = triangulateFace(d, d.face.data(), n)) return Fail{where() + ": " + f->what};

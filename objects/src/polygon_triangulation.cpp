@@ -26,6 +26,7 @@ Triangulation triangulatePolygon(std::span<const glm::vec3> corners, std::vector
                                  TriangulationScratch& s) {
     const std::size_t n = corners.size();
     if (n < 3) return Triangulation::ZeroArea;
+    if (n > 0xFFFFFFFFu) return Triangulation::TooComplex;  // corners are named by 32-bit indices
     if (n == 3) {
         out.insert(out.end(), {0u, 1u, 2u});
         return Triangulation::Ok;
