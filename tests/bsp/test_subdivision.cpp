@@ -544,6 +544,35 @@ TEST_F(SubdivisionFileContentTest, NodeRangesNear2To32AreRefused) {
     EXPECT_NE(error(), "");
 }
 
+TEST_F(SubdivisionFileContentTest, ParametersNear2To32AreRefusedOrHarmless) {
+    const std::vector<char> good = bytes();
+    patch(kParams, std::uint8_t{0xFF});
+    expectRefused("unknown method 255");
+    for (std::uint32_t v : {0xFFFFFFFFu, 0x80000000u}) {
+        write(good);
+        patch(kParams + 5, v);
+        expectRefused("maximum depth " + std::to_string(v) + " above");
+        write(good);
+        patch(kParams + 13, v);
+        expectRefused("SAH bins must be in 2..256");
+        // Limits that only loosen: the stored tree still satisfies them, so the file loads
+        // (maxLeafTriangles) or the field only matters to a rebuild (exactBelow, collapseTo).
+        for (std::size_t field : {std::size_t{1}, std::size_t{9}, std::size_t{25}}) {
+            write(good);
+            patch(kParams + field, v);
+            EXPECT_EQ(error(), "") << field;
+        }
+    }
+    for (float f : {NAN, INFINITY, -1.0f}) {
+        write(good);
+        patch(kParams + 17, f);
+        expectRefused("plane move must be in [0, 0.5)");
+        write(good);
+        patch(kParams + 21, f);
+        expectRefused("pull-up width must be finite and >= 0");
+    }
+}
+
 TEST_F(SubdivisionFileContentTest, NonFiniteBuildTimeIsRefused) {
     const std::size_t buildMs = bytes().size() - 16;
     patch(buildMs, std::numeric_limits<double>::quiet_NaN());
