@@ -79,7 +79,7 @@ TEST(ObjLoader, IndexOutOfRange) {
     expectError(loadObj(path), path, "line 4: vertex index 9 out of range (3 vertices)");
 }
 
-// Issue 19: OBJ used to read unparsable numbers as 0 and clamp huge indices.
+// Issue 19: unparsable or non-finite numbers and out-of-range indices are errors with a line number.
 struct BadObj {
     const char* name;
     std::string text;
