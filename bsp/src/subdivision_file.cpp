@@ -4,6 +4,7 @@
 #include "dyncull/bsp/subdivision_file.hpp"
 
 #include <bit>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <type_traits>
@@ -224,6 +225,7 @@ Expected<SubdividedModel> readSubdivisionFile(const std::filesystem::path& path)
     if (!r.str(m.mesh.name, 4096) || !r.array(m.mesh.positions) || !r.array(m.mesh.normals) || !r.array(m.mesh.indices))
         return bad(path, "truncated mesh");
     if (std::string why = validateMesh(m.mesh); !why.empty()) return bad(path, why);
+    if (std::string why = validateNormals(m.mesh); !why.empty()) return bad(path, why);
     const auto nodes = r.get<std::uint64_t>();
     if (r.failed() || nodes == 0 || nodes > r.left() / kNodeBytes) return bad(path, "node count out of range");
     Subdivision& sub = m.subdivision;
@@ -241,6 +243,7 @@ Expected<SubdividedModel> readSubdivisionFile(const std::filesystem::path& path)
     sub.stats.buildMs = r.get<double>();
     sub.stats.workBytes = static_cast<std::size_t>(r.get<std::uint64_t>());
     if (r.failed()) return bad(path, "truncated tree");
+    if (!std::isfinite(sub.stats.buildMs) || sub.stats.buildMs < 0.0) return bad(path, "build time is not a finite duration");
     if (r.left() != 0) return bad(path, std::to_string(r.left()) + " trailing payload bytes");
     if (std::string why = validateSubdivision(m.mesh, sub, p.maxLeafTriangles, p.maxDepth); !why.empty())
         return bad(path, why);

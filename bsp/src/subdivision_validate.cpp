@@ -48,7 +48,9 @@ std::string validateSubdivision(const Mesh& mesh, const Subdivision& sub, std::u
         }
         if (v.childCount < 2) return at + "inner node with fewer than two children";
         if (v.firstChild <= i || v.firstChild > n || v.childCount > n - v.firstChild) return at + "children out of range";
-        std::uint32_t next = v.firstTriangle;
+        // 64-bit sums of 32-bit counts cannot wrap (at most 2^32 children), so a corrupt
+        // child count cannot make the tiling check pass by overflow.
+        std::uint64_t next = v.firstTriangle;
         Aabb box;
         for (std::uint32_t c = 0; c < v.childCount; ++c) {
             const std::size_t k = v.firstChild + c;
@@ -58,7 +60,7 @@ std::string validateSubdivision(const Mesh& mesh, const Subdivision& sub, std::u
             next += sub.nodes[k].triangleCount;
             box.extend(sub.nodes[k].box);
         }
-        if (next != v.firstTriangle + v.triangleCount) return at + "children do not tile its triangle range";
+        if (next != std::uint64_t{v.firstTriangle} + v.triangleCount) return at + "children do not tile its triangle range";
         if (!(box.min == v.box.min && box.max == v.box.max)) return at + "box is not the union of its children";
         if (!v.box.empty() && !v.box.finite()) return at + "non-finite box";
     }

@@ -59,4 +59,15 @@ std::string validateMesh(const Mesh& mesh) {
     return {};
 }
 
+std::string validateNormals(const Mesh& mesh) {
+    for (std::size_t i = 0; i < mesh.normals.size(); ++i) {
+        const glm::vec3& n = mesh.normals[i];
+        if (!std::isfinite(n.x) || !std::isfinite(n.y) || !std::isfinite(n.z))
+            return "normal " + std::to_string(i) + " is not finite";
+        // Writers store unit normals; one shorter than 1e-6 has no reliable direction left.
+        if (!(glm::dot(n, n) >= 1e-12f)) return "normal " + std::to_string(i) + " has zero length";
+    }
+    return {};
+}
+
 }  // namespace dyncull

@@ -13,8 +13,10 @@
 #include <string_view>
 #include <vector>
 
+#include "checked_math.hpp"
 #include "dyncull/objects/loaders.hpp"
 #include "loader_common.hpp"
+#include "polygon_triangulation.hpp"
 
 namespace dyncull {
 namespace {
@@ -262,29 +264,65 @@ struct AsciiReader {
     bool integer(std::int64_t& out) { return value(out); }
 };
 
+// Output arrays grow only as values are read and checked (never sized from header
+// counts), so memory stays proportional to the data actually present in the file.
 struct PlyData {
+    const Element* vertex = nullptr;
+    bool withNormals = false;
+    glm::vec3 position{0.0f}, normal{0.0f};  // the vertex being read
     std::vector<glm::vec3> positions, normals;
     std::vector<std::uint32_t> indices;
+    // Faces read before the vertex element is complete wait here (corners, then sizes)
+    // until their positions are known, since triangulation needs them.
+    std::vector<std::uint32_t> deferredCorners, deferredSizes;
+    std::vector<std::uint32_t> face, local;
+    std::vector<glm::vec3> corners;
+    detail::TriangulationScratch scratch;
 };
 
 std::string elementWhere(const Element& e, std::uint64_t i) { return e.name + " " + std::to_string(i); }
 
-// Stores a parsed vertex property into the output arrays.
-void storeVertexValue(PlyData& d, std::uint64_t v, Role role, double value) {
+// Stores a parsed vertex property into the vertex being read.
+void storeVertexValue(PlyData& d, Role role, double value) {
     const float f = static_cast<float>(value);
     switch (role) {
-        case Role::X: d.positions[v].x = f; break;
-        case Role::Y: d.positions[v].y = f; break;
-        case Role::Z: d.positions[v].z = f; break;
-        case Role::NX: d.normals[v].x = f; break;
-        case Role::NY: d.normals[v].y = f; break;
-        case Role::NZ: d.normals[v].z = f; break;
+        case Role::X: d.position.x = f; break;
+        case Role::Y: d.position.y = f; break;
+        case Role::Z: d.position.z = f; break;
+        case Role::NX: d.normal.x = f; break;
+        case Role::NY: d.normal.y = f; break;
+        case Role::NZ: d.normal.z = f; break;
         default: break;
     }
 }
 
-// Appends a polygon, fan-triangulated; checks indices against the vertex count.
-// `where` is a callable giving the location (built only on error, it allocates).
+// Called after each element instance: a complete vertex is appended.
+void endInstance(PlyData& d, const Element& e) {
+    if (&e != d.vertex) return;
+    d.positions.push_back(d.position);
+    if (d.withNormals) d.normals.push_back(d.normal);
+    d.position = d.normal = glm::vec3(0.0f);
+}
+
+// Triangulates one face whose indices are in range and whose positions are all read.
+std::optional<Fail> triangulateFace(PlyData& d, const std::uint32_t* idx, std::size_t n) {
+    if (n == 3) {  // the common case needs no geometry
+        d.indices.insert(d.indices.end(), idx, idx + 3);
+        return std::nullopt;
+    }
+    d.corners.clear();
+    for (std::size_t k = 0; k < n; ++k) d.corners.push_back(d.positions[idx[k]]);
+    d.local.clear();
+    // Zero-area polygons give no triangles; self-intersecting ones give best-effort triangles.
+    if (detail::triangulatePolygon(d.corners, d.local, d.scratch) == detail::Triangulation::TooComplex)
+        return Fail{"face with " + std::to_string(n) + " corners is too complex to triangulate"};
+    for (std::uint32_t k : d.local) d.indices.push_back(idx[k]);
+    return std::nullopt;
+}
+
+// Appends a polygon; checks indices against the vertex count. Faces with fewer than 3
+// corners are not surfaces: dropped on purpose. `where` is a callable giving the
+// location (built only on error, it allocates).
 template <class Where>
 std::optional<Fail> addFace(PlyData& d, const std::int64_t* idx, std::size_t n, std::uint64_t vertexCount,
                             const Where& where) {
@@ -292,11 +330,25 @@ std::optional<Fail> addFace(PlyData& d, const std::int64_t* idx, std::size_t n, 
         if (idx[k] < 0 || static_cast<std::uint64_t>(idx[k]) >= vertexCount)
             return Fail{where() + ": vertex index " + std::to_string(idx[k]) + " out of range (" +
                         std::to_string(vertexCount) + " vertices)"};
-    // Faces with fewer than 3 corners are not surfaces: dropped on purpose.
-    for (std::size_t k = 1; k + 1 < n; ++k) {
-        d.indices.push_back(static_cast<std::uint32_t>(idx[0]));
-        d.indices.push_back(static_cast<std::uint32_t>(idx[k]));
-        d.indices.push_back(static_cast<std::uint32_t>(idx[k + 1]));
+    if (n < 3) return std::nullopt;
+    if (n > 0xFFFFFFFFu) return Fail{where() + ": face with more than 2^32 - 1 corners"};  // ASCII list counts are 64-bit
+    d.face.clear();
+    for (std::size_t k = 0; k < n; ++k) d.face.push_back(static_cast<std::uint32_t>(idx[k]));  // < vertexCount < 2^32
+    if (d.positions.size() < vertexCount) {
+        d.deferredCorners.insert(d.deferredCorners.end(), d.face.begin(), d.face.end());
+        d.deferredSizes.push_back(static_cast<std::uint32_t>(n));
+        return std::nullopt;
+    }
+    if (auto f = triangulateFace(d, d.face.data(), n)) return Fail{where() + ": " + f->what};
+    return std::nullopt;
+}
+
+// Faces that came before the vertex element, now that every position is known.
+std::optional<Fail> triangulateDeferred(PlyData& d) {
+    std::size_t at = 0;
+    for (std::uint32_t n : d.deferredSizes) {
+        if (auto f = triangulateFace(d, d.deferredCorners.data() + at, n)) return f;
+        at += n;
     }
     return std::nullopt;
 }
@@ -315,7 +367,7 @@ std::optional<Fail> parseAscii(std::string_view data, const Header& h, std::uint
                     double v = 0.0;
                     if (!r.number(p.type, v))
                         return Fail{where() + ": " + (r.atLineEnd() ? "missing" : "bad") + " value for '" + p.name + "'"};
-                    storeVertexValue(d, i, p.role, v);
+                    storeVertexValue(d, p.role, v);
                     continue;
                 }
                 std::int64_t n = 0;
@@ -323,18 +375,23 @@ std::optional<Fail> parseAscii(std::string_view data, const Header& h, std::uint
                     return Fail{where() + ": " + (r.atLineEnd() ? "missing" : "bad") + " list count for '" + p.name + "'"};
                 list.clear();
                 for (std::int64_t k = 0; k < n; ++k) {
-                    double v = 0.0;
-                    if (!r.number(p.type, v))
+                    if (r.atLineEnd())
                         return Fail{where() + ": list '" + p.name + "' has fewer than " + std::to_string(n) + " entries"};
                     if (p.role == Role::Indices) {
-                        if (v != std::floor(v)) return Fail{where() + ": non-integer vertex index"};
-                        list.push_back(static_cast<std::int64_t>(v));
+                        // Read as an integer: going through double would round (and overflow) large values.
+                        std::int64_t index = 0;
+                        if (!r.integer(index)) return Fail{where() + ": bad vertex index in '" + p.name + "'"};
+                        list.push_back(index);
+                        continue;
                     }
+                    double v = 0.0;
+                    if (!r.number(p.type, v)) return Fail{where() + ": bad value in list '" + p.name + "'"};
                 }
                 if (p.role == Role::Indices)
                     if (auto f = addFace(d, list.data(), list.size(), vertexCount, where)) return f;
             }
             if (!r.atLineEnd()) return Fail{where() + ": more values than the header declares"};
+            endInstance(d, e);
         }
     }
     if (r.nextLine())
@@ -349,6 +406,7 @@ std::optional<Fail> parseBinary(std::string_view data, const Header& h, std::uin
                    reinterpret_cast<const unsigned char*>(data.data()) + data.size(), fileBig != hostBig};
     std::vector<std::int64_t> list;
     for (const Element& e : h.elements) {
+        if (e.props.empty()) continue;  // nothing stored: a huge count must not mean a huge loop
         for (std::uint64_t i = 0; i < e.count; ++i) {
             for (const Property& p : e.props) {
                 auto truncated = [&] {
@@ -358,14 +416,15 @@ std::optional<Fail> parseBinary(std::string_view data, const Header& h, std::uin
                 if (!p.isList) {
                     if (!r.has(typeSize(p.type))) return truncated();
                     const double v = r.number(p.type);
-                    storeVertexValue(d, i, p.role, v);
+                    storeVertexValue(d, p.role, v);
                     continue;
                 }
                 if (!r.has(typeSize(p.countType))) return truncated();
                 const std::int64_t n = r.integer(p.countType);
                 if (n < 0) return Fail{elementWhere(e, i) + ": negative list count for '" + p.name + "'"};
-                const std::size_t bytes = static_cast<std::size_t>(n) * typeSize(p.type);
-                if (!r.has(bytes)) return truncated();
+                std::size_t bytes = 0;
+                if (!detail::checkedMul(static_cast<std::size_t>(n), typeSize(p.type), bytes) || !r.has(bytes))
+                    return truncated();
                 if (p.role != Role::Indices) {
                     r.p += bytes;
                     continue;
@@ -375,6 +434,7 @@ std::optional<Fail> parseBinary(std::string_view data, const Header& h, std::uin
                 if (auto f = addFace(d, list.data(), list.size(), vertexCount, [&] { return elementWhere(e, i); }))
                     return f;
             }
+            endInstance(d, e);
         }
     }
     if (r.p != r.end) {
@@ -384,6 +444,25 @@ std::optional<Fail> parseBinary(std::string_view data, const Header& h, std::uin
                 return Fail{std::to_string(r.end - r.p) + " bytes of data after the last element (header counts too small?)"};
     }
     return std::nullopt;
+}
+
+/// The most instances of `e` that `dataBytes` bytes of element data can hold. Binary:
+/// each instance takes at least its fixed-size properties plus its list counts. ASCII:
+/// each value takes at least one character and one separator (space or newline), except
+/// that the file's last newline may be missing. An element without properties reads
+/// nothing, so any count fits.
+std::uint64_t maxInstances(Format format, const Element& e, std::uint64_t dataBytes) {
+    std::uint64_t minBytes = 0;
+    if (format == Format::Ascii) {
+        if (!detail::checkedMul<std::uint64_t>(e.props.size(), 2, minBytes)) return 0;
+    } else {
+        for (const Property& p : e.props)
+            if (!detail::checkedAdd<std::uint64_t>(minBytes, p.isList ? typeSize(p.countType) : typeSize(p.type), minBytes))
+                return 0;
+    }
+    if (minBytes == 0) return UINT64_MAX;
+    // dataBytes is a file size, far below 2^64 - 1, so the +1 cannot wrap.
+    return (format == Format::Ascii ? dataBytes + 1 : dataBytes) / minBytes;
 }
 
 Expected<Scene> loadPlyImpl(const std::filesystem::path& path) {
@@ -424,27 +503,20 @@ Expected<Scene> loadPlyImpl(const std::filesystem::path& path) {
     }
     if (!hasIndices) return detail::fileError(path, "face element has no vertex_indices list");
 
-    // Every element instance takes at least one byte, so larger counts are wrong headers;
-    // checking before allocating keeps a corrupt count from exhausting memory.
-    const std::size_t dataBytes = data.size() - h.dataOffset;
-    for (const Element& e : h.elements) {
-        std::uint64_t minBytes = 1;
-        if (h.format != Format::Ascii) {
-            minBytes = 0;
-            for (const Property& p : e.props) minBytes += p.isList ? typeSize(p.countType) : typeSize(p.type);
-        }
-        if (minBytes > 0 && e.count > dataBytes / minBytes)
+    // A header count larger than the data can hold is a wrong header: say so up front.
+    // (Memory does not depend on it either way: the arrays grow only as data is read.)
+    const std::uint64_t dataBytes = data.size() - h.dataOffset;
+    for (const Element& e : h.elements)
+        if (e.count > maxInstances(h.format, e, dataBytes))
             return detail::fileError(path, "header declares " + std::to_string(e.count) + " " + e.name +
                                                " entries but the file is too short (truncated?)");
-    }
 
     PlyData d;
-    d.positions.assign(static_cast<std::size_t>(vertex->count), glm::vec3(0.0f));
-    if (normalProps == 3) d.normals.assign(static_cast<std::size_t>(vertex->count), glm::vec3(0.0f));
-    else
+    d.vertex = vertex;
+    d.withNormals = normalProps == 3;
+    if (!d.withNormals)
         for (Property& p : vertex->props)
             if (p.role == Role::NX || p.role == Role::NY || p.role == Role::NZ) p.role = Role::Skip;
-    d.indices.reserve(static_cast<std::size_t>(face->count) * 3);
 
     // Only the vertex element stores values; the same roles on other elements are skipped.
     for (Element& e : h.elements)
@@ -455,13 +527,15 @@ Expected<Scene> loadPlyImpl(const std::filesystem::path& path) {
     const auto fail = h.format == Format::Ascii ? parseAscii(data, h, vertex->count, d)
                                                 : parseBinary(data, h, vertex->count, d);
     if (fail) return detail::fileError(path, fail->what);
+    if (auto f = triangulateDeferred(d)) return detail::fileError(path, f->what);
 
     for (std::size_t i = 0; i < d.positions.size(); ++i) {
         const glm::vec3& p = d.positions[i];
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
             return detail::fileError(path, "vertex " + std::to_string(i) + " has a non-finite coordinate");
     }
-    if (d.indices.empty()) return detail::fileError(path, "no triangles (every face has fewer than 3 vertices)");
+    if (d.indices.empty())
+        return detail::fileError(path, "no triangles (every face has fewer than 3 vertices or zero area)");
 
     Mesh mesh;
     mesh.name = path.stem().string();

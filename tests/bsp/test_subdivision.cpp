@@ -4,10 +4,12 @@
 // degenerate inputs, the 4-ary collapse, leaf models and the subdivision file.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 
 #include "dyncull/bsp/subdivision.hpp"
@@ -414,6 +416,169 @@ TEST_F(SubdivisionFileTest, WellFormedButWrongContentIsRefused) {
     const std::string e = error();
     EXPECT_NE(e, "");
     EXPECT_EQ(e.find("checksum"), std::string::npos) << e;
+}
+
+// Issue 19: a .dsub with a valid checksum is still checked field by field.
+class SubdivisionFileContentTest : public SubdivisionFileTest {
+protected:
+    // Payload offsets of this fixture's file: source string, method, 6 parameters,
+    // collapseTo, mesh name, then the three counted arrays.
+    static constexpr std::size_t kSource = kSubdivisionFileHeaderSize;  // u32 length, "model.ply"
+    static constexpr std::size_t kParams = kSource + 4 + 9;
+    static constexpr std::size_t kName = kParams + 1 + 4 * 4 + 2 * 4 + 4;  // u32 length, "soup"
+    static constexpr std::size_t kPositions = kName + 4 + 4;                // u64 count, then 12 bytes each
+    std::size_t normalsAt(std::size_t positions) const { return kPositions + 8 + 12 * positions; }
+    std::size_t indicesAt() const { return normalsAt(model_.mesh.positions.size()) + 8 + 12 * model_.mesh.normals.size(); }
+    std::size_t nodesAt() const { return indicesAt() + 8 + 4 * model_.mesh.indices.size(); }
+
+    // Rewrites the file with `value` at `offset` and a checksum that matches again.
+    template <class T>
+    void patch(std::size_t offset, T value) {
+        std::vector<char> b = bytes();
+        ASSERT_LE(offset + sizeof(T), b.size());
+        std::memcpy(b.data() + offset, &value, sizeof(T));
+        const std::uint64_t sum = fnv1a64(b.data() + kSubdivisionFileHeaderSize, b.size() - kSubdivisionFileHeaderSize);
+        std::memcpy(b.data() + 32, &sum, 8);
+        write(b);
+    }
+    void rewrite() { ASSERT_TRUE(writeSubdivisionFile(path_, model_)); }
+    void expectRefused(const std::string& what) {
+        const std::string e = error();
+        EXPECT_NE(e.find(what), std::string::npos) << "expected '" << what << "' in: " << e;
+        EXPECT_EQ(e.rfind("subdivision file " + path_.string() + ": ", 0), 0u) << e;
+        EXPECT_EQ(e.find("checksum"), std::string::npos) << e;
+    }
+};
+
+TEST_F(SubdivisionFileContentTest, NanOrZeroNormalsAreRefusedDespiteAValidChecksum) {
+    computeNormals(model_.mesh);
+    rewrite();
+    ASSERT_EQ(error(), "");
+    const Mesh good = model_.mesh;
+    for (float bad : {NAN, INFINITY, -INFINITY}) {
+        model_.mesh.normals[3].y = bad;
+        rewrite();
+        expectRefused("normal 3 is not finite");
+        model_.mesh = good;
+    }
+    model_.mesh.normals[5] = glm::vec3(0.0f);
+    rewrite();
+    expectRefused("normal 5 has zero length");
+    model_.mesh.normals[5] = glm::vec3(1e-7f, 0.0f, 0.0f);
+    rewrite();
+    expectRefused("normal 5 has zero length");
+    model_.mesh = good;
+    model_.mesh.normals.pop_back();
+    rewrite();
+    expectRefused("normal count");
+}
+
+TEST_F(SubdivisionFileContentTest, NonFinitePositionsAndBadIndicesAreRefused) {
+    model_.mesh.positions[7].z = NAN;
+    rewrite();
+    expectRefused("vertex 7 has a non-finite coordinate");
+    model_.mesh.positions[7].z = INFINITY;
+    rewrite();
+    expectRefused("vertex 7 has a non-finite coordinate");
+    SetUp();  // the original model again
+    for (std::uint32_t index : {static_cast<std::uint32_t>(model_.mesh.positions.size()), 0x7FFFFFFFu, 0xFFFFFFFFu}) {
+        patch(indicesAt() + 8 + 4 * 10, index);
+        expectRefused("index " + std::to_string(index) + " at position 10 out of range");
+    }
+}
+
+TEST_F(SubdivisionFileContentTest, CountsNear2To32And2To64AreRefused) {
+    const std::vector<char> good = bytes();
+    auto restore = [&] { write(good); };
+    for (std::uint64_t n : {std::uint64_t{0xFFFFFFFF}, std::uint64_t{1} << 32, (std::uint64_t{1} << 32) + 1,
+                            std::uint64_t{1} << 63, ~std::uint64_t{0}, ~std::uint64_t{0} / 12 + 1}) {
+        SCOPED_TRACE(n);
+        patch(kPositions, n);
+        expectRefused("truncated mesh");
+        restore();
+        patch(normalsAt(model_.mesh.positions.size()), n);
+        expectRefused("truncated mesh");
+        restore();
+        patch(indicesAt(), n);
+        expectRefused("truncated mesh");
+        restore();
+        patch(nodesAt(), n);
+        expectRefused("node count out of range");
+        restore();
+    }
+    for (std::uint32_t n : {0xFFFFFFFFu, 0x80000000u, 4097u}) {
+        patch(kSource, n);
+        expectRefused("truncated source name");
+        restore();
+        patch(kName, n);
+        expectRefused("truncated mesh");
+        restore();
+    }
+    // The header's payload size, which the file size must match exactly.
+    for (std::uint64_t n : {std::uint64_t{0xFFFFFFFF}, std::uint64_t{1} << 32, ~std::uint64_t{0}}) {
+        std::vector<char> b = good;
+        std::memcpy(b.data() + 24, &n, 8);
+        write(b);
+        EXPECT_NE(error().find("truncated or padded: header says " + std::to_string(n)), std::string::npos) << error();
+    }
+}
+
+TEST_F(SubdivisionFileContentTest, NodeRangesNear2To32AreRefused) {
+    const std::size_t root = nodesAt() + 8;  // box (24 bytes), firstChild, childCount, firstTriangle, triangleCount, depth
+    const std::vector<char> good = bytes();
+    for (std::uint32_t v : {0xFFFFFFFFu, 0xFFFFFFFEu, 0x80000000u}) {
+        for (std::size_t field : {24u, 28u, 32u, 36u, 40u}) {
+            SCOPED_TRACE(std::to_string(field) + " " + std::to_string(v));
+            patch(root + field, v);
+            EXPECT_NE(error(), "");
+            write(good);
+        }
+    }
+    // A child's count chosen so that the parent's tiling sum would wrap in 32 bits.
+    ASSERT_GE(model_.subdivision.nodes.size(), 3u);
+    const SubdivisionNode& r = model_.subdivision.nodes[0];
+    ASSERT_FALSE(r.isLeaf());
+    const std::size_t first = nodesAt() + 8 + 44 * r.firstChild;
+    const SubdivisionNode& c0 = model_.subdivision.nodes[r.firstChild];
+    patch(first + 36, static_cast<std::uint32_t>(c0.triangleCount + (std::uint64_t{1} << 32) - r.triangleCount));
+    EXPECT_NE(error(), "");
+}
+
+TEST_F(SubdivisionFileContentTest, ParametersNear2To32AreRefusedOrHarmless) {
+    const std::vector<char> good = bytes();
+    patch(kParams, std::uint8_t{0xFF});
+    expectRefused("unknown method 255");
+    for (std::uint32_t v : {0xFFFFFFFFu, 0x80000000u}) {
+        write(good);
+        patch(kParams + 5, v);
+        expectRefused("maximum depth " + std::to_string(v) + " above");
+        write(good);
+        patch(kParams + 13, v);
+        expectRefused("SAH bins must be in 2..256");
+        // Limits that only loosen: the stored tree still satisfies them, so the file loads
+        // (maxLeafTriangles) or the field only matters to a rebuild (exactBelow, collapseTo).
+        for (std::size_t field : {std::size_t{1}, std::size_t{9}, std::size_t{25}}) {
+            write(good);
+            patch(kParams + field, v);
+            EXPECT_EQ(error(), "") << field;
+        }
+    }
+    for (float f : {NAN, INFINITY, -1.0f}) {
+        write(good);
+        patch(kParams + 17, f);
+        expectRefused("plane move must be in [0, 0.5)");
+        write(good);
+        patch(kParams + 21, f);
+        expectRefused("pull-up width must be finite and >= 0");
+    }
+}
+
+TEST_F(SubdivisionFileContentTest, NonFiniteBuildTimeIsRefused) {
+    const std::size_t buildMs = bytes().size() - 16;
+    patch(buildMs, std::numeric_limits<double>::quiet_NaN());
+    expectRefused("build time is not a finite duration");
+    patch(buildMs, -1.0);
+    expectRefused("build time");
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 // Scene cache: round trip, and every kind of damage (flipped byte, truncation, other
 // version, other parameters, garbage) detected with a reason and then rebuilt.
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -223,6 +224,114 @@ TEST(SceneCacheFile, PreparedSceneMatchesGeneratedCounts) {
     EXPECT_EQ(p->objects.size(), objects);
     EXPECT_EQ(p->models.size(), meshes);
     EXPECT_GE(p->instancedTriangles(), tris);  // splitting only adds triangles
+}
+
+// Issue 19: a cache with a valid checksum is still checked field by field.
+class SceneCacheContent : public SceneCache {
+protected:
+    std::filesystem::path file() const { return dir_.path() / "c.dcs"; }
+    // One model with normals and a split root, placed once: known offsets, every record present.
+    static PreparedScene oneModel() {
+        PreparedScene one;
+        for (const LocalBsp& b : scene_->models)
+            if (b.nodes.size() > 1 && !b.mesh.normals.empty() && b.mesh.positions.size() > 4) {
+                one.models.push_back(b);
+                break;
+            }
+        EXPECT_EQ(one.models.size(), 1u);
+        one.objects.push_back({0, Transform{}, true});
+        return one;
+    }
+    std::string readError() const {
+        auto r = readSceneCache(file(), 5);
+        return r ? std::string() : r.error().message;
+    }
+    void expectRefused(const std::string& what) const {
+        const std::string e = readError();
+        EXPECT_NE(e.find(what), std::string::npos) << "expected '" << what << "' in: " << e;
+        EXPECT_EQ(e.rfind("scene cache " + file().string() + ": ", 0), 0u) << e;
+        EXPECT_EQ(e.find("checksum"), std::string::npos) << e;
+    }
+    // Rewrites `bytes` with `value` at `offset` and a matching checksum.
+    template <class T>
+    void patch(std::vector<char> bytes, std::size_t offset, T value) const {
+        ASSERT_LE(offset + sizeof(T), bytes.size());
+        std::memcpy(bytes.data() + offset, &value, sizeof(T));
+        const std::uint64_t sum = fnv1a64(bytes.data() + kSceneCacheHeaderSize, bytes.size() - kSceneCacheHeaderSize);
+        std::memcpy(bytes.data() + 32, &sum, 8);
+        writeAll(file(), bytes);
+    }
+};
+
+TEST_F(SceneCacheContent, NanOrZeroNormalsAndNanPositionsAreRefused) {
+    const PreparedScene good = oneModel();
+    ASSERT_EQ(good.models.size(), 1u);
+    ASSERT_TRUE(writeSceneCache(file(), good, 5).ok());
+    ASSERT_EQ(readError(), "");
+    PreparedScene bad = good;
+    for (float v : {NAN, INFINITY}) {
+        bad.models[0].mesh.normals[2].x = v;
+        ASSERT_TRUE(writeSceneCache(file(), bad, 5).ok());
+        expectRefused("model 0: normal 2 is not finite");
+        bad = good;
+    }
+    bad.models[0].mesh.normals[4] = glm::vec3(0.0f);
+    ASSERT_TRUE(writeSceneCache(file(), bad, 5).ok());
+    expectRefused("model 0: normal 4 has zero length");
+    bad = good;
+    bad.models[0].mesh.positions[1].y = NAN;
+    ASSERT_TRUE(writeSceneCache(file(), bad, 5).ok());
+    expectRefused("model 0: vertex 1 has a non-finite coordinate");
+    bad = good;
+    bad.models[0].stats.buildMs = NAN;
+    ASSERT_TRUE(writeSceneCache(file(), bad, 5).ok());
+    expectRefused("model 0: build time is not a finite duration");
+}
+
+TEST_F(SceneCacheContent, CountsAndRangesNear2To32AreRefused) {
+    const PreparedScene scene = oneModel();
+    ASSERT_EQ(scene.models.size(), 1u);
+    ASSERT_TRUE(writeSceneCache(file(), scene, 5).ok());
+    const std::vector<char> good = readAll(file());
+    const Mesh& m = scene.models[0].mesh;
+    const std::size_t H = kSceneCacheHeaderSize;
+    const std::size_t name = H + 4;
+    const std::size_t positions = name + 4 + m.name.size();
+    const std::size_t normals = positions + 4 + 12 * m.positions.size();
+    const std::size_t indices = normals + 4 + 12 * m.normals.size();
+    const std::size_t nodes = indices + 4 + 4 * m.indices.size();
+    const std::size_t root = nodes + 4;  // box 24, children 2 x 4, firstIndex, indexCount, subtreeSize, split, axis, depth
+    const std::size_t objects = good.size() - 4 - 45 * scene.objects.size();
+    for (std::uint32_t n : {0xFFFFFFFFu, 0xFFFFFFFEu, 0x80000000u}) {
+        SCOPED_TRACE(n);
+        patch(good, H, n);
+        expectRefused("model count out of range");
+        patch(good, name, n);
+        expectRefused("model 0: truncated mesh");
+        patch(good, positions, n);
+        expectRefused("model 0: truncated mesh");
+        patch(good, normals, n);
+        expectRefused("model 0: truncated mesh");
+        patch(good, indices, n);
+        expectRefused("model 0: truncated mesh");
+        patch(good, nodes, n);
+        expectRefused("model 0: node count out of range");
+        patch(good, objects, n);
+        expectRefused("object count out of range");
+        for (std::size_t field : {24u, 28u, 32u, 36u, 40u}) {
+            patch(good, root + field, n);
+            expectRefused("model 0: node 0: ");
+        }
+        patch(good, good.size() - 45, n);  // the last object's model
+        expectRefused("model out of range");
+    }
+    for (std::uint64_t payload : {std::uint64_t{0xFFFFFFFF}, std::uint64_t{1} << 32, ~std::uint64_t{0}}) {
+        std::vector<char> b = good;
+        std::memcpy(b.data() + 24, &payload, 8);
+        writeAll(file(), b);
+        EXPECT_NE(readError().find("truncated or padded: header says " + std::to_string(payload)), std::string::npos)
+            << readError();
+    }
 }
 
 }  // namespace

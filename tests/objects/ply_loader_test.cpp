@@ -328,5 +328,147 @@ TEST(PlyLoader, OnlyDegenerateFaces) {
     expectError(loadPly(path), path, "no triangles");
 }
 
+// Issue 19: every count read from the file is checked before it sizes anything, with
+// values at and around 2^32 and 2^64.
+std::string triangleHeader(const std::string& format, const std::string& vertexCount, const std::string& faceCount,
+                           const std::string& countType = "uchar", const std::string& extra = "") {
+    return "ply\nformat " + format + " 1.0\n" + extra + "element vertex " + vertexCount +
+           "\nproperty float x\nproperty float y\nproperty float z\nelement face " + faceCount + "\nproperty list " +
+           countType + " int vertex_indices\nend_header\n";
+}
+const char* kTriangleBody = "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+
+TEST(PlyLoader, HeaderCountsNear2To32And2To64) {
+    struct Case {
+        const char* vertices;
+        const char* faces;
+        const char* what;
+    };
+    const Case cases[] = {
+        {"4294967295", "1", "header declares 4294967295 vertex entries but the file is too short"},
+        {"4294967296", "1", "too many vertices for 32-bit indices"},
+        {"4294967297", "1", "too many vertices for 32-bit indices"},
+        {"18446744073709551615", "1", "too many vertices for 32-bit indices"},
+        {"18446744073709551616", "1", "bad element count '18446744073709551616'"},
+        {"-1", "1", "bad element count '-1'"},
+        {"3", "4294967295", "header declares 4294967295 face entries"},
+        {"3", "4294967296", "header declares 4294967296 face entries"},
+        {"3", "18446744073709551615", "header declares 18446744073709551615 face entries"},
+        {"3", "99999999999999999999999", "bad element count"},
+    };
+    for (const std::string format : {"ascii", "binary_little_endian", "binary_big_endian"}) {
+        for (const Case& c : cases) {
+            SCOPED_TRACE(format + " " + c.vertices + " " + c.faces);
+            TempDir dir;
+            // Padded so every case fails on its own count, not on the vertices' bytes.
+            const auto path = dir.write("count.ply", triangleHeader(format, c.vertices, c.faces) + kTriangleBody +
+                                                         std::string(64, '\n'));
+            expectError(loadPly(path), path, c.what);
+        }
+    }
+}
+
+TEST(PlyLoader, ElementWithoutPropertiesAndHugeCountIsNoEndlessLoop) {
+    // Binary: nothing to read per instance, so the count is harmless and the file loads.
+    std::string bin = triangleHeader("binary_little_endian", "3", "1", "uchar", "element nothing 18446744073709551615\n");
+    for (float f : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) put(bin, f, false);
+    put<std::uint8_t>(bin, 3, false);
+    for (std::int32_t i : {0, 1, 2}) put(bin, i, false);
+    TempDir dir;
+    const auto binPath = dir.write("empty_element.ply", bin);
+    auto r = loadPly(binPath);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(r->meshes[0].triangleCount(), 1u);
+    // ASCII: each instance would need a line of its own.
+    const auto asciiPath =
+        dir.write("empty_element_ascii.ply",
+                  triangleHeader("ascii", "3", "1", "uchar", "element nothing 18446744073709551615\n") + kTriangleBody);
+    expectError(loadPly(asciiPath), asciiPath, "line 11: nothing 0: more values than the header declares");
+}
+
+TEST(PlyLoader, ListCountsNear2To32) {
+    TempDir dir;
+    for (bool big : {false, true}) {
+        const std::string format = big ? "binary_big_endian" : "binary_little_endian";
+        auto file = [&](const std::string& countType, auto count) {
+            std::string s = triangleHeader(format, "3", "1", countType);
+            for (float f : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) put(s, f, big);
+            put(s, count, big);
+            for (std::int32_t i : {0, 1, 2}) put(s, i, big);
+            return s;
+        };
+        const auto u32 = dir.write("u32.ply", file("uint", std::uint32_t{0xFFFFFFFFu}));
+        expectError(loadPly(u32), u32, "file truncated in face 0 of 1");
+        const auto u32b = dir.write("u32b.ply", file("uint", std::uint32_t{0x80000000u}));
+        expectError(loadPly(u32b), u32b, "file truncated in face 0 of 1");
+        const auto i32 = dir.write("i32.ply", file("int", std::int32_t{-1}));
+        expectError(loadPly(i32), i32, "face 0: negative list count");
+        const auto i32min = dir.write("i32min.ply", file("int", std::int32_t{INT32_MIN}));
+        expectError(loadPly(i32min), i32min, "face 0: negative list count");
+    }
+    // ASCII list counts are read as 64-bit: the line runs out first.
+    for (const char* count : {"4294967296", "9223372036854775807"}) {
+        const auto path = dir.write("ascii_list.ply", triangleHeader("ascii", "3", "1") + "0 0 0\n1 0 0\n0 1 0\n" +
+                                                          count + " 0 1 2\n");
+        expectError(loadPly(path), path, std::string("list 'vertex_indices' has fewer than ") + count + " entries");
+    }
+    const auto neg = dir.write("ascii_neg.ply", triangleHeader("ascii", "3", "1") + "0 0 0\n1 0 0\n0 1 0\n-3 0 1 2\n");
+    expectError(loadPly(neg), neg, "bad list count");
+}
+
+TEST(PlyLoader, AsciiIndicesNear2To32And2To63) {
+    TempDir dir;
+    const std::pair<const char*, const char*> cases[] = {
+        {"4294967295", "vertex index 4294967295 out of range (3 vertices)"},
+        {"4294967296", "vertex index 4294967296 out of range (3 vertices)"},
+        {"9223372036854775807", "vertex index 9223372036854775807 out of range (3 vertices)"},
+        {"-9223372036854775808", "vertex index -9223372036854775808 out of range (3 vertices)"},
+        {"9223372036854775808", "bad vertex index in 'vertex_indices'"},
+        {"18446744073709551616", "bad vertex index in 'vertex_indices'"},
+        {"1.5", "bad vertex index"},
+        {"nan", "bad vertex index"},
+    };
+    for (const auto& [index, what] : cases) {
+        SCOPED_TRACE(index);
+        const auto path = dir.write("index.ply", triangleHeader("ascii", "3", "1") + "0 0 0\n1 0 0\n0 1 0\n3 0 1 " +
+                                                      index + "\n");
+        expectError(loadPly(path), path, std::string("line 13: face 0: ") + what);
+    }
+}
+
+TEST(PlyLoader, ConcaveFaceIsEarClipped) {
+    // An L-shaped hexagon: the fan from corner 0 would leave the L (triangle 0 3 4 crosses
+    // the notch); ear clipping covers exactly its area of 5.
+    TempDir dir;
+    const auto path = dir.write("l.ply", triangleHeader("ascii", "6", "1") +
+                                             "1 3 0\n0 3 0\n0 0 0\n3 0 0\n3 1 0\n1 1 0\n6 0 1 2 3 4 5\n");
+    auto r = loadPly(path);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(r->meshes[0].triangleCount(), 4u);
+    EXPECT_NEAR(surfaceArea(r->meshes[0]), 5.0, 1e-6);
+    for (const glm::vec3& n : r->meshes[0].normals) EXPECT_NEAR(n.z, 1.0f, 1e-6f);
+}
+
+TEST(PlyLoader, FacesBeforeVerticesAreTriangulatedOnceTheVerticesAreRead) {
+    TempDir dir;
+    const auto path = dir.write("faces_first.ply",
+                                "ply\nformat ascii 1.0\nelement face 2\nproperty list uchar int vertex_indices\n"
+                                "element vertex 6\nproperty float x\nproperty float y\nproperty float z\nend_header\n"
+                                "6 0 1 2 3 4 5\n3 0 1 2\n1 1 0\n1 3 0\n0 3 0\n0 0 0\n3 0 0\n3 1 0\n");
+    auto r = loadPly(path);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(r->meshes[0].triangleCount(), 5u);
+    EXPECT_NEAR(surfaceArea(r->meshes[0]), 5.0 + 1.0, 1e-6);
+}
+
+TEST(PlyLoader, ZeroAreaPolygonsAreDropped) {
+    TempDir dir;
+    const auto path = dir.write("flat.ply", triangleHeader("ascii", "4", "2") +
+                                                "0 0 0\n1 0 0\n2 0 0\n0 1 0\n4 0 1 2 0\n3 0 1 3\n");
+    auto r = loadPly(path);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(r->meshes[0].triangleCount(), 1u);
+}
+
 }  // namespace
 }  // namespace dyncull

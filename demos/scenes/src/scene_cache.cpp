@@ -232,6 +232,7 @@ Expected<PreparedScene> readSceneCache(const std::filesystem::path& path, std::u
         if (!r.str(b.mesh.name) || !r.array(b.mesh.positions) || !r.array(b.mesh.normals) || !r.array(b.mesh.indices))
             return bad(path, at + "truncated mesh");
         if (std::string why = validateMesh(b.mesh); !why.empty()) return bad(path, at + why);
+        if (std::string why = validateNormals(b.mesh); !why.empty()) return bad(path, at + why);
         const std::uint32_t nodes = r.get<std::uint32_t>();
         constexpr std::size_t kNodeBytes = 24 + 4 * 5 + 4 + 2;
         if (r.failed() || nodes > r.left() / kNodeBytes) return bad(path, at + "node count out of range");
@@ -255,6 +256,7 @@ Expected<PreparedScene> readSceneCache(const std::filesystem::path& path, std::u
         b.stats.stalledLeaves = r.get<std::uint32_t>();
         b.stats.buildMs = r.get<double>();
         if (r.failed()) return bad(path, at + "truncated tree");
+        if (!std::isfinite(b.stats.buildMs) || b.stats.buildMs < 0.0) return bad(path, at + "build time is not a finite duration");
         if (std::string why = validateTree(b); !why.empty()) return bad(path, at + why);
     }
     const std::uint32_t objects = r.get<std::uint32_t>();

@@ -1,8 +1,8 @@
-// Scene loading from files: PLY (own parser), Wavefront OBJ (tinyobjloader) and
+// Scene loading from files: PLY and Wavefront OBJ (own parsers) and
 // glTF 2.0 (tinygltf). Every loader returns either a complete Scene or an Error whose
 // one-line message starts with the file path and names the problem; it never returns a
 // half-filled Scene. Every returned mesh has passed validateMesh(), is an indexed
-// triangle list (polygons fan-triangulated) and has unit normals (from the file when
+// triangle list (polygons ear-clipped) and has unit normals (from the file when
 // present and valid, otherwise computeNormals()).
 #pragma once
 
@@ -20,13 +20,19 @@ Expected<Scene> loadScene(const std::filesystem::path& path);
 /// PLY in ascii, binary_little_endian or binary_big_endian. Needs a `vertex` element
 /// with x, y, z and a `face` element with a `vertex_indices` (or `vertex_index`) list;
 /// other elements and properties (confidence, intensity, flags, ...) are skipped.
-/// Optional nx, ny, nz vertex properties are used as normals. Faces with fewer than 3
-/// vertices are dropped. Result: one mesh, one identity instance; units as in the file.
+/// Optional nx, ny, nz vertex properties are used as normals. Polygons are ear-clipped;
+/// faces with fewer than 3 vertices and zero-area polygons are dropped. Arrays grow as
+/// data is read, never from header counts. Result: one mesh, one identity instance;
+/// units as in the file.
 Expected<Scene> loadPly(const std::filesystem::path& path);
 
 /// Wavefront OBJ. One mesh (and one identity instance) per OBJ shape (o/g group) that
 /// has faces; vertices are deduplicated per mesh by (position, normal) index pair.
 /// Materials and texture coordinates are ignored; a missing .mtl file is not an error.
+/// Every number must parse and be finite, every index must name an element defined
+/// earlier in the file, and a face needs 3 corners; otherwise the Error names the line.
+/// Polygons are ear-clipped: zero-area ones are dropped, self-intersecting ones get
+/// best-effort triangles.
 Expected<Scene> loadObj(const std::filesystem::path& path);
 
 /// glTF 2.0, .gltf (external or base64 buffers) or .glb. Walks the default scene (or

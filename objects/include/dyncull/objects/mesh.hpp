@@ -34,4 +34,8 @@ double surfaceArea(const Mesh& mesh);
 /// finite positions, normals empty or one per position. Returns a message or "" if valid.
 std::string validateMesh(const Mesh& mesh);
 
+/// Checks that every normal is finite and not (near) zero: what a reader of a file that
+/// stores normals must check, since such a normal shades black. Returns a message or "".
+std::string validateNormals(const Mesh& mesh);
+
 }  // namespace dyncull
