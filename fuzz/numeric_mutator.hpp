@@ -176,10 +176,21 @@ inline bool plainMutation() {
     return plain;
 }
 
+/// DYNCULL_FUZZ_NO_NESTING=1 turns the nesting mutation off, so that a run looks for the
+/// other bug classes once deep nesting is known (scripts/fuzz_rediscover.sh --no-nesting).
+inline bool nestingOff() {
+    static const bool off = [] {
+        const char* v = std::getenv("DYNCULL_FUZZ_NO_NESTING");
+        return v && std::string_view(v) == "1";
+    }();
+    return off;
+}
+
 /// The custom mutation for a text format: boundary numbers with probability 1/3, deep
 /// nesting (when `nest`) 1/64, else libFuzzer's own mutation (dictionary included).
 inline std::size_t mutateText(std::uint8_t* data, std::size_t size, std::size_t maxSize, unsigned seed, bool nest) {
     if (plainMutation()) return LLVMFuzzerMutate(data, size, maxSize);
+    nest = nest && !nestingOff();
     std::minstd_rand rng(seed);
     const unsigned dice = static_cast<unsigned>(rng() % 192);
     std::size_t n = 0;
