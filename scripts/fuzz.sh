@@ -85,7 +85,7 @@ for t in "${TARGETS[@]}"; do
   pids+=($!)
   if ((${#pids[@]} == PARALLEL)); then
     wait "${pids[0]}" || status=1
-    pids=("${pids[1]}")
+    pids=("${pids[@]:1}")
   fi
 done
 for p in "${pids[@]}"; do wait "$p" || status=1; done
