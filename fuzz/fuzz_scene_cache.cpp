@@ -10,10 +10,16 @@
 #include <vector>
 
 #include "fuzz_file.hpp"
+#include "numeric_mutator.hpp"
 #include "scene_cache.hpp"
 
 namespace {
 constexpr std::uint64_t kHash = 0x5eed;
+}
+
+// Boundary values in the payload's counts and offsets (numeric_mutator.hpp, issue 19).
+extern "C" std::size_t LLVMFuzzerCustomMutator(std::uint8_t* data, std::size_t size, std::size_t maxSize, unsigned seed) {
+    return dyncull::fuzz::mutateBinary(data, size, maxSize, seed, dyncull::kSceneCacheHeaderSize);
 }
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

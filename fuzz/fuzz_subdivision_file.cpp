@@ -10,6 +10,12 @@
 #include "dyncull/bsp/subdivision_file.hpp"
 #include "dyncull/objects/checksum.hpp"
 #include "fuzz_file.hpp"
+#include "numeric_mutator.hpp"
+
+// Boundary values in the payload's counts and offsets (numeric_mutator.hpp, issue 19).
+extern "C" std::size_t LLVMFuzzerCustomMutator(std::uint8_t* data, std::size_t size, std::size_t maxSize, unsigned seed) {
+    return dyncull::fuzz::mutateBinary(data, size, maxSize, seed, dyncull::kSubdivisionFileHeaderSize);
+}
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     using namespace dyncull;
