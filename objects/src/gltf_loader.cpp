@@ -1,12 +1,15 @@
 // glTF 2.0 loading (.gltf and .glb) through tinygltf. tinygltf parses JSON and buffers;
 // we read accessors ourselves (byteStride, every component type, bounds checks), merge a
 // mesh's triangle primitives into one dyncull Mesh and walk the node hierarchy.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <exception>
+#include <limits>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/gtc/quaternion.hpp>
@@ -29,6 +32,97 @@ bool ignoreImage(tinygltf::Image*, const int, std::string*, std::string*, int, i
     return true;
 }
 
+constexpr const char* kDraco = "KHR_draco_mesh_compression";
+
+std::string dracoMessage() {
+    return std::string("the geometry is Draco-compressed (") + kDraco +
+           "), which dyncull does not decode; decompress the file first, e.g. with glTF Transform: "
+           "npx @gltf-transform/cli copy in.glb out.glb (its copy command removes Draco compression)";
+}
+
+// glTF needs fewer than 10 levels; the limit only has to stop a recursive JSON parser
+// from running out of stack.
+constexpr int kMaxJsonDepth = 64;
+
+// True when `text` nests arrays/objects deeper than `limit`. Brackets inside strings do
+// not count; a malformed text is left for the JSON parser to report.
+bool jsonNestsDeeperThan(std::string_view text, int limit) {
+    int depth = 0;
+    bool inString = false;
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (inString) {
+            if (c == '\\') ++i;  // the escaped character cannot end the string
+            else if (c == '"') inString = false;
+        } else if (c == '"') {
+            inString = true;
+        } else if (c == '[' || c == '{') {
+            if (++depth > limit) return true;
+        } else if ((c == ']' || c == '}') && depth > 0) {
+            --depth;
+        }
+    }
+    return false;
+}
+
+// Checks the GLB header and chunk table (tinygltf does not check the version, and lets
+// the BIN chunk end up to 8 bytes past the file) and returns the JSON chunk in `json`.
+std::optional<Fail> checkGlb(const std::string& bytes, std::string_view& json) {
+    auto u32 = [&](std::size_t at) {
+        std::uint32_t v;
+        std::memcpy(&v, bytes.data() + at, 4);  // little-endian, as is every host we build for
+        return v;
+    };
+    if (bytes.size() < 20) return Fail{"GLB file shorter than its 20-byte header"};
+    if (bytes.compare(0, 4, "glTF") != 0) return Fail{"not a GLB file (no 'glTF' magic)"};
+    if (u32(4) != 2) return Fail{"GLB version " + std::to_string(u32(4)) + " is not supported (only version 2)"};
+    const std::uint64_t length = u32(8);
+    if (length > bytes.size())
+        return Fail{"GLB header length " + std::to_string(length) + " exceeds the file size " +
+                    std::to_string(bytes.size())};
+    const std::uint64_t jsonLength = u32(12);
+    if (u32(16) != 0x4E4F534Au) return Fail{"GLB first chunk is not JSON"};
+    if (jsonLength == 0 || !detail::rangeInside(20, jsonLength, length))
+        return Fail{"GLB JSON chunk length " + std::to_string(jsonLength) + " does not fit in the file"};
+    const std::uint64_t binAt = 20 + jsonLength;
+    if (binAt < length) {
+        if (!detail::rangeInside(binAt, 8, length)) return Fail{"GLB chunk header after the JSON chunk is truncated"};
+        const std::uint64_t binLength = u32(static_cast<std::size_t>(binAt));
+        if (!detail::rangeInside(binAt + 8, binLength, length))
+            return Fail{"GLB BIN chunk length " + std::to_string(binLength) + " runs past the end of the file"};
+    }
+    json = std::string_view(bytes).substr(20, static_cast<std::size_t>(jsonLength));
+    return std::nullopt;
+}
+
+// tinygltf's own file callbacks open the file to test that it exists (which blocks on a
+// pipe) and read directories and devices (a buffer uri of "." asks it to allocate the size
+// a directory stream reports): external buffers must be regular files.
+bool bufferFileExists(const std::string& filepath, void*) {
+    std::error_code ec;
+    return std::filesystem::exists(filepath, ec);
+}
+
+bool readBufferFile(std::vector<unsigned char>* out, std::string* err, const std::string& filepath, void*) {
+    std::string bytes;
+    if (Status s = detail::readWholeFile(filepath, bytes); !s) {
+        if (err) *err += s.message();
+        return false;
+    }
+    out->assign(bytes.begin(), bytes.end());
+    return true;
+}
+
+// Required extensions that only change materials, textures or lights (which culling
+// ignores) or allow component types the accessor reader handles anyway.
+bool canIgnoreRequired(const std::string& ext) {
+    static const char* const kIgnorable[] = {"KHR_mesh_quantization", "KHR_texture_transform", "KHR_texture_basisu",
+                                             "EXT_texture_webp", "EXT_texture_avif", "KHR_lights_punctual"};
+    for (const char* e : kIgnorable)
+        if (ext == e) return true;
+    return ext.rfind("KHR_materials_", 0) == 0;
+}
+
 // A validated view of an accessor's bytes.
 struct AccessorView {
     const unsigned char* base = nullptr;
@@ -46,27 +140,51 @@ std::optional<Fail> viewAccessor(const tinygltf::Model& model, int index, int wa
     if (a.sparse.isSparse) return Fail{where + ": sparse accessors are not supported"};
     if (a.bufferView < 0 || static_cast<std::size_t>(a.bufferView) >= model.bufferViews.size())
         return Fail{where + ": no valid bufferView"};
+    const std::string viewName = "bufferView " + std::to_string(a.bufferView);
     const tinygltf::BufferView& bv = model.bufferViews[static_cast<std::size_t>(a.bufferView)];
     if (bv.buffer < 0 || static_cast<std::size_t>(bv.buffer) >= model.buffers.size())
-        return Fail{where + ": bufferView refers to a missing buffer"};
+        return Fail{viewName + " (of " + where + ") refers to a missing buffer"};
     const tinygltf::Buffer& buf = model.buffers[static_cast<std::size_t>(bv.buffer)];
+    const std::uint64_t bufSize = buf.data.size();
+    if (bv.byteOffset > bufSize)
+        return Fail{viewName + ": byteOffset " + std::to_string(bv.byteOffset) + " is past the end of buffer " +
+                    std::to_string(bv.buffer) + " (" + std::to_string(bufSize) + " bytes)"};
+    if (!detail::rangeInside(bv.byteOffset, bv.byteLength, bufSize))
+        return Fail{viewName + ": byteLength " + std::to_string(bv.byteLength) + " at byteOffset " +
+                    std::to_string(bv.byteOffset) + " reads past the end of buffer " + std::to_string(bv.buffer) +
+                    " (" + std::to_string(bufSize) + " bytes)"};
+
     const int compSize = tinygltf::GetComponentSizeInBytes(static_cast<std::uint32_t>(a.componentType));
     const int comps = tinygltf::GetNumComponentsInType(static_cast<std::uint32_t>(a.type));
     if (compSize <= 0 || comps <= 0) return Fail{where + ": unknown component type or element type"};
     if (comps != wantComponents)
         return Fail{where + ": has " + std::to_string(comps) + " components, expected " + std::to_string(wantComponents)};
-    const std::size_t elemSize = static_cast<std::size_t>(compSize) * static_cast<std::size_t>(comps);
-    const std::size_t stride = bv.byteStride ? bv.byteStride : elemSize;
-    if (stride < elemSize) return Fail{where + ": byteStride " + std::to_string(stride) + " smaller than an element"};
-    // The last element must lie inside both the buffer view and the buffer.
-    const std::size_t need = a.count == 0 ? 0 : a.byteOffset + stride * (a.count - 1) + elemSize;
-    if (a.count > 0 && (stride * (a.count - 1) / stride != a.count - 1 || need > bv.byteLength))
-        return Fail{where + ": reads past the end of its bufferView"};
-    if (bv.byteOffset + bv.byteLength > buf.data.size())
-        return Fail{"bufferView " + std::to_string(a.bufferView) + ": reads past the end of its buffer (" +
-                    std::to_string(buf.data.size()) + " bytes)"};
+    const std::uint64_t elemSize = static_cast<std::uint64_t>(compSize) * static_cast<std::uint64_t>(comps);  // <= 8 * 16
+    std::uint64_t stride = elemSize;
+    if (bv.byteStride != 0) {
+        // glTF 2.0 allows 4..252 in steps of 4 (tinygltf enforces only the upper bound and the step).
+        if (bv.byteStride < 4 || bv.byteStride > 252 || bv.byteStride % 4 != 0)
+            return Fail{viewName + ": byteStride " + std::to_string(bv.byteStride) +
+                        " is not a multiple of 4 in 4..252"};
+        if (bv.byteStride < elemSize)
+            return Fail{viewName + ": byteStride " + std::to_string(bv.byteStride) + " is smaller than the " +
+                        std::to_string(elemSize) + "-byte elements of " + where};
+        stride = bv.byteStride;
+    }
+    if (a.byteOffset > bv.byteLength)
+        return Fail{where + ": byteOffset " + std::to_string(a.byteOffset) + " is past the end of " + viewName +
+                    " (" + std::to_string(bv.byteLength) + " bytes)"};
+    // The last element must lie inside the buffer view: byteOffset + stride * (count - 1) + elemSize.
+    std::uint64_t span = 0;
+    if (a.count > 0 && (!detail::checkedMul<std::uint64_t>(stride, a.count - 1, span) ||
+                        !detail::checkedAdd<std::uint64_t>(span, elemSize, span) ||
+                        !detail::rangeInside(a.byteOffset, span, bv.byteLength)))
+        return Fail{where + ": count " + std::to_string(a.count) + " (stride " + std::to_string(stride) +
+                    ", byteOffset " + std::to_string(a.byteOffset) + ") reads past the end of " + viewName + " (" +
+                    std::to_string(bv.byteLength) + " bytes)"};
+    // Both offsets are now known to lie inside the buffer, so their sum does too.
     out.base = buf.data.data() + bv.byteOffset + a.byteOffset;
-    out.stride = stride;
+    out.stride = static_cast<std::size_t>(stride);
     out.count = a.count;
     out.componentType = a.componentType;
     out.components = comps;
@@ -141,6 +259,12 @@ std::optional<Fail> appendPrimitive(const tinygltf::Model& model, const tinygltf
         return std::nullopt;
     const auto posIt = prim.attributes.find("POSITION");
     if (posIt == prim.attributes.end()) return std::nullopt;  // nothing to place (allowed by the spec)
+    // A Draco primitive's accessors may carry an uncompressed fallback; without one they
+    // have no bufferView and only the Draco stream holds the geometry.
+    if (prim.extensions.count(kDraco) && posIt->second >= 0 &&
+        static_cast<std::size_t>(posIt->second) < model.accessors.size() &&
+        model.accessors[static_cast<std::size_t>(posIt->second)].bufferView < 0)
+        return Fail{dracoMessage()};
 
     std::vector<glm::vec3> pos, nrm;
     if (auto f = readVec3(model, posIt->second, pos)) return Fail{"POSITION " + f->what};
@@ -172,6 +296,10 @@ std::optional<Fail> appendPrimitive(const tinygltf::Model& model, const tinygltf
         for (std::size_t i = 0; i < idx.size(); ++i) idx[i] = static_cast<std::uint32_t>(i);
     }
 
+    std::uint64_t total = 0;
+    if (!detail::checkedAdd<std::uint64_t>(mesh.positions.size(), pos.size(), total) ||
+        total > std::numeric_limits<std::uint32_t>::max())
+        return Fail{"more than 2^32 - 1 vertices in one mesh"};
     const auto base = static_cast<std::uint32_t>(mesh.positions.size());
     auto tri = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
         mesh.indices.push_back(base + a);
@@ -238,16 +366,41 @@ glm::mat4 localMatrix(const tinygltf::Node& n) {
 }
 
 Expected<Scene> loadGltfImpl(const std::filesystem::path& path) {
-    if (Status s = detail::checkFile(path); !s) return Error{s.message()};
-    tinygltf::TinyGLTF loader;
-    loader.SetImageLoader(ignoreImage, nullptr);
-    tinygltf::Model model;
-    std::string err, warn;
+    std::string bytes;
+    if (Status s = detail::readWholeFile(path, bytes); !s) return Error{s.message()};
+    if (bytes.size() > std::numeric_limits<unsigned int>::max())
+        return detail::fileError(path, "larger than 4 GiB, which tinygltf cannot address");
     std::string ext = path.extension().string();
     for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    const bool ok = ext == ".glb" ? loader.LoadBinaryFromFile(&model, &err, &warn, path.string())
-                                  : loader.LoadASCIIFromFile(&model, &err, &warn, path.string());
-    if (!ok) return detail::fileError(path, err.empty() ? "cannot parse glTF" : err);
+    const bool binary = ext == ".glb";
+    std::string_view json = bytes;
+    if (binary)
+        if (auto f = checkGlb(bytes, json)) return detail::fileError(path, f->what);
+    if (jsonNestsDeeperThan(json, kMaxJsonDepth))
+        return detail::fileError(path, "JSON nests deeper than " + std::to_string(kMaxJsonDepth) +
+                                           " levels (glTF needs fewer than 10)");
+
+    tinygltf::TinyGLTF loader;
+    loader.SetImageLoader(ignoreImage, nullptr);
+    loader.SetFsCallbacks({&bufferFileExists, &tinygltf::ExpandFilePath, &readBufferFile, &tinygltf::WriteWholeFile, nullptr});
+    tinygltf::Model model;
+    std::string err, warn;
+    const std::string baseDir = path.parent_path().string();
+    const bool ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, reinterpret_cast<const unsigned char*>(bytes.data()),
+                                                         static_cast<unsigned int>(bytes.size()), baseDir)
+                           : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(),
+                                                        static_cast<unsigned int>(bytes.size()), baseDir);
+    if (!ok) {
+        if (err.empty()) err = "cannot parse glTF";
+        // tinygltf rejects a Draco primitive's indices accessor (no bufferView) before we
+        // see the extension: name the real cause, keep the parser's words.
+        if (json.find(kDraco) != std::string_view::npos) return detail::fileError(path, dracoMessage() + " (" + err + ")");
+        return detail::fileError(path, err);
+    }
+    for (const std::string& e : model.extensionsRequired) {
+        if (e == kDraco) return detail::fileError(path, dracoMessage());
+        if (!canIgnoreRequired(e)) return detail::fileError(path, "requires the unsupported extension " + e);
+    }
     if (model.meshes.empty()) return detail::fileError(path, "no meshes");
 
     // Roots: the default scene, else scene 0, else every node that is nobody's child.

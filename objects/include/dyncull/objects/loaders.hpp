@@ -34,8 +34,11 @@ Expected<Scene> loadObj(const std::filesystem::path& path);
 /// an Instance whose transform is the node's world matrix (object -> world, glTF units,
 /// usually metres). Each glTF mesh used is loaded once into one dyncull Mesh (its
 /// triangle, strip and fan primitives merged) and shared by all nodes using it; point
-/// and line primitives are skipped. Sparse accessors, node cycles and nodes whose world
-/// matrix is non-finite or singular are reported as an Error. Images are not decoded.
+/// and line primitives are skipped. Reported as an Error: sparse
+/// accessors, offsets/lengths/strides/counts outside their buffer, JSON nested deeper
+/// than 64, GLB versions other than 2, unsupported required extensions (Draco included),
+/// buffer URIs that are not regular files, node cycles, and nodes whose world matrix is
+/// non-finite or singular. Images are not decoded.
 Expected<Scene> loadGltf(const std::filesystem::path& path);
 
 }  // namespace dyncull
