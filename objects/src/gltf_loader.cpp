@@ -340,30 +340,59 @@ std::optional<Fail> buildMesh(const tinygltf::Model& model, int meshIndex, Mesh&
     return std::nullopt;
 }
 
-glm::mat4 localMatrix(const tinygltf::Node& n) {
-    if (n.matrix.size() == 16) {
-        glm::mat4 m;
+std::string nodeName(int index, const tinygltf::Node& n) {
+    return "node " + std::to_string(index) + (n.name.empty() ? std::string() : " ('" + n.name + "')");
+}
+
+// The node's local matrix in double: hierarchies far from the origin (1e7 and beyond)
+// lose whole units when composed in float.
+std::optional<Fail> localMatrix(const tinygltf::Node& n, glm::dmat4& m) {
+    if (!n.matrix.empty()) {
+        if (n.matrix.size() != 16) return Fail{"matrix has " + std::to_string(n.matrix.size()) + " elements, expected 16"};
         for (int c = 0; c < 4; ++c)
-            for (int r = 0; r < 4; ++r) m[c][r] = static_cast<float>(n.matrix[static_cast<std::size_t>(4 * c + r)]);
-        return m;  // glTF matrices are column-major, like glm
+            for (int r = 0; r < 4; ++r) m[c][r] = n.matrix[static_cast<std::size_t>(4 * c + r)];  // column-major, like glm
+        // Node matrices must be affine; a projective bottom row makes w vary per vertex
+        // (0 0 0 0 sends every vertex to infinity). Exporters write it exactly.
+        constexpr double kTol = 1e-9;
+        if (std::abs(m[0][3]) > kTol || std::abs(m[1][3]) > kTol || std::abs(m[2][3]) > kTol ||
+            std::abs(m[3][3] - 1.0) > kTol)
+            return Fail{"matrix is not affine (bottom row " + std::to_string(m[0][3]) + " " + std::to_string(m[1][3]) +
+                        " " + std::to_string(m[2][3]) + " " + std::to_string(m[3][3]) + ", expected 0 0 0 1)"};
+        return std::nullopt;
     }
-    glm::mat4 m(1.0f);
+    if (!n.scale.empty() && n.scale.size() != 3) return Fail{"scale has " + std::to_string(n.scale.size()) + " elements, expected 3"};
+    if (!n.rotation.empty() && n.rotation.size() != 4)
+        return Fail{"rotation has " + std::to_string(n.rotation.size()) + " elements, expected 4"};
+    if (!n.translation.empty() && n.translation.size() != 3)
+        return Fail{"translation has " + std::to_string(n.translation.size()) + " elements, expected 3"};
+    m = glm::dmat4(1.0);
     if (n.scale.size() == 3) {
-        m[0][0] = static_cast<float>(n.scale[0]);
-        m[1][1] = static_cast<float>(n.scale[1]);
-        m[2][2] = static_cast<float>(n.scale[2]);
+        m[0][0] = n.scale[0];
+        m[1][1] = n.scale[1];
+        m[2][2] = n.scale[2];
     }
     if (n.rotation.size() == 4) {
-        // glTF stores (x, y, z, w); glm::quat's constructor takes (w, x, y, z).
-        const glm::quat q(static_cast<float>(n.rotation[3]), static_cast<float>(n.rotation[0]),
-                          static_cast<float>(n.rotation[1]), static_cast<float>(n.rotation[2]));
+        // glTF stores (x, y, z, w); glm::dquat's constructor takes (w, x, y, z).
+        const glm::dquat q(n.rotation[3], n.rotation[0], n.rotation[1], n.rotation[2]);
         m = glm::mat4_cast(q) * m;
     }
-    if (n.translation.size() == 3)
-        m[3] = glm::vec4(static_cast<float>(n.translation[0]), static_cast<float>(n.translation[1]),
-                         static_cast<float>(n.translation[2]), 1.0f);
-    return m;
+    if (n.translation.size() == 3) m[3] = glm::dvec4(n.translation[0], n.translation[1], n.translation[2], 1.0);
+    return std::nullopt;
 }
+
+// Largest world coordinate accepted: products of two (squared distances, plane tests) stay far inside float range.
+constexpr double kMaxWorldCoordinate = 1e15;
+
+// Instance transforms are stored relative to Scene::origin when the scene lies farther
+// from the file's origin than this many times its own radius: beyond that, float
+// translations lose more than ~1e-6 of the scene's size.
+constexpr double kRecentreRatio = 16.0;
+
+struct PendingInstance {
+    std::uint32_t mesh;
+    glm::dmat4 world;
+    int node;
+};
 
 Expected<Scene> loadGltfImpl(const std::filesystem::path& path) {
     std::string bytes;
@@ -421,27 +450,33 @@ Expected<Scene> loadGltfImpl(const std::filesystem::path& path) {
     Scene scene;
     constexpr std::uint32_t kNotLoaded = 0xFFFFFFFFu, kEmpty = 0xFFFFFFFEu;
     std::vector<std::uint32_t> meshSlot(model.meshes.size(), kNotLoaded);  // glTF mesh -> Scene mesh
+    std::vector<Aabb> meshBounds;
+    std::vector<PendingInstance> pending;
+    glm::dvec3 lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
     std::vector<char> visited(model.nodes.size(), 0);
     struct Item {
         int node;
-        glm::mat4 parent;
+        glm::dmat4 parent;
     };
     std::vector<Item> stack;
-    for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, glm::mat4(1.0f)});
+    for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, glm::dmat4(1.0)});
     while (!stack.empty()) {
         const Item item = stack.back();
         stack.pop_back();
         if (item.node < 0 || static_cast<std::size_t>(item.node) >= model.nodes.size())
             return detail::fileError(path, "node " + std::to_string(item.node) + " does not exist");
         const auto ni = static_cast<std::size_t>(item.node);
-        // glTF nodes form a forest: a second visit means a cycle or a shared child.
-        if (visited[ni]) return detail::fileError(path, "node " + std::to_string(item.node) + " is reached twice (cycle in the node hierarchy)");
-        visited[ni] = 1;
         const tinygltf::Node& node = model.nodes[ni];
-        const glm::mat4 world = item.parent * localMatrix(node);
+        const std::string name = nodeName(item.node, node);
+        // glTF nodes form a forest: a second visit means a cycle or a shared child.
+        if (visited[ni]) return detail::fileError(path, name + " is reached twice (cycle in the node hierarchy)");
+        visited[ni] = 1;
+        glm::dmat4 local;
+        if (auto f = localMatrix(node, local)) return detail::fileError(path, name + ": " + f->what);
+        const glm::dmat4 world = item.parent * local;
         if (node.mesh >= 0) {
             if (static_cast<std::size_t>(node.mesh) >= model.meshes.size())
-                return detail::fileError(path, "node " + std::to_string(item.node) + ": mesh " + std::to_string(node.mesh) + " does not exist");
+                return detail::fileError(path, name + ": mesh " + std::to_string(node.mesh) + " does not exist");
             std::uint32_t& slot = meshSlot[static_cast<std::size_t>(node.mesh)];
             if (slot == kNotLoaded) {
                 Mesh mesh;
@@ -450,18 +485,41 @@ Expected<Scene> loadGltfImpl(const std::filesystem::path& path) {
                     slot = kEmpty;
                 } else {
                     slot = static_cast<std::uint32_t>(scene.meshes.size());
+                    meshBounds.push_back(mesh.bounds());
                     scene.meshes.push_back(std::move(mesh));
                 }
             }
             if (slot != kEmpty) {
-                if (Status s = validateMatrix(world); !s)
-                    return detail::fileError(path, "node " + std::to_string(item.node) + ": " + s.message());
-                scene.instances.push_back(Instance{slot, world, node.name.empty() ? "node " + std::to_string(item.node) : node.name});
+                const Aabb& b = meshBounds[slot];
+                for (int corner = 0; corner < 8; ++corner) {
+                    const glm::dvec4 p = world * glm::dvec4(corner & 1 ? b.max.x : b.min.x, corner & 2 ? b.max.y : b.min.y,
+                                                            corner & 4 ? b.max.z : b.min.z, 1.0);
+                    for (int k = 0; k < 3; ++k)
+                        if (!(std::abs(p[k]) <= kMaxWorldCoordinate))  // also catches NaN
+                            return detail::fileError(path, name + ": places mesh '" + scene.meshes[slot].name +
+                                                               "' beyond the accepted world range (|coordinate| <= 1e15)");
+                    lo = glm::min(lo, glm::dvec3(p));
+                    hi = glm::max(hi, glm::dvec3(p));
+                }
+                pending.push_back({slot, world, item.node});
             }
         }
         for (auto c = node.children.rbegin(); c != node.children.rend(); ++c) stack.push_back({*c, world});
     }
-    if (scene.instances.empty()) return detail::fileError(path, "the scene has no node with a triangle mesh");
+    if (pending.empty()) return detail::fileError(path, "the scene has no node with a triangle mesh");
+
+    const glm::dvec3 centre = (lo + hi) * 0.5;
+    if (glm::length(centre) > kRecentreRatio * glm::length(hi - lo) * 0.5) scene.origin = centre;
+    scene.instances.reserve(pending.size());
+    for (const PendingInstance& p : pending) {
+        glm::dmat4 relative = p.world;
+        relative[3] -= glm::dvec4(scene.origin, 0.0);
+        const glm::mat4 transform(relative);
+        const tinygltf::Node& node = model.nodes[static_cast<std::size_t>(p.node)];
+        if (Status s = validateMatrix(transform); !s)
+            return detail::fileError(path, nodeName(p.node, node) + ": " + s.message());
+        scene.instances.push_back(Instance{p.mesh, transform, node.name.empty() ? "node " + std::to_string(p.node) : node.name});
+    }
     return scene;
 }
 

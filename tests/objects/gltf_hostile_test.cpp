@@ -1,8 +1,12 @@
 // Hostile glTF input (issue 19): out-of-range offsets, lengths, strides and counts,
-// deep JSON nesting, GLB headers, required extensions and buffer URIs. Every case must be
-// an Error naming the file and the field.
+// deep JSON nesting, GLB headers, required extensions, buffer URIs, node matrices and
+// far-from-origin scenes. Every case must be an Error naming the file and the field.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -93,6 +97,7 @@ TEST(GltfHostile, BaselineDocLoads) {
     ASSERT_TRUE(r.ok()) << r.error().message;
     ASSERT_EQ(r->instances.size(), 1u);
     EXPECT_EQ(r->meshes[0].triangleCount(), 1u);
+    EXPECT_EQ(r->origin, glm::dvec3(0.0));
 }
 
 // ---- 1. offsets, lengths, strides and counts ------------------------------------------
@@ -418,6 +423,193 @@ TEST(GltfHostile, BufferUriEmptyOrMissing) {
     expectError(load(dir, d, path), path, "uri");
     d.buffer = R"("byteLength": 44, "uri": "missing.bin")";
     expectError(load(dir, d, path), path, "missing.bin");
+}
+
+// ---- 5. precision far from the origin ------------------------------------------------
+
+TEST(GltfPrecision, FourInstancesUnder1e8RootStayTwoUnitsApart) {
+    TempDir dir;
+    Doc d;
+    d.nodes = R"([{"name": "root", "translation": [1e8, 0, 0], "children": [1, 2, 3, 4]},
+                 {"mesh": 0, "translation": [0, 0, 0]}, {"mesh": 0, "translation": [2, 0, 0]},
+                 {"mesh": 0, "translation": [4, 0, 0]}, {"mesh": 0, "translation": [6, 0, 0]}])";
+    std::filesystem::path path;
+    auto r = load(dir, d, path);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    ASSERT_EQ(r->instances.size(), 4u);
+    EXPECT_NE(r->origin, glm::dvec3(0.0));
+    for (std::size_t i = 0; i < 4; ++i) {
+        const glm::mat4& t = r->instances[i].transform;
+        EXPECT_EQ(r->origin.x + static_cast<double>(t[3].x), 1e8 + 2.0 * static_cast<double>(i)) << i;
+        EXPECT_EQ(r->origin.y + static_cast<double>(t[3].y), 0.0);
+        if (i > 0) {
+            EXPECT_EQ(t[3].x - r->instances[i - 1].transform[3].x, 2.0f) << i;
+        }
+        EXPECT_EQ(glm::mat3(t), glm::mat3(1.0f));
+    }
+    // The stored (relative) coordinates are small: the scene is centred on its origin.
+    EXPECT_LT(std::abs(r->worldBounds().center().x), 1.0f);
+}
+
+// Compares every instance of `far` (a copy of `near` moved by `offset`) with `near`, in
+// world space, to `tol` per matrix element.
+void expectSamePlacement(const Scene& near, const Scene& far, const glm::dvec3& offset, double tol) {
+    ASSERT_EQ(near.instances.size(), far.instances.size());
+    const glm::dvec3 shift = far.origin - offset - near.origin;  // far's relative frame in near's relative frame
+    for (std::size_t i = 0; i < near.instances.size(); ++i) {
+        const glm::dmat4 a(near.instances[i].transform);
+        glm::dmat4 b(far.instances[i].transform);
+        b[3] += glm::dvec4(shift, 0.0);
+        for (int c = 0; c < 4; ++c)
+            for (int k = 0; k < 4; ++k) EXPECT_NEAR(a[c][k], b[c][k], tol) << "instance " << i << " [" << c << "][" << k << "]";
+    }
+}
+
+TEST(GltfPrecision, HierarchyFarFromOriginMatchesTheSameAtTheOrigin) {
+    TempDir dir;
+    const std::string children = R"(
+        {"name": "arm", "translation": [3.25, -1.5, 7], "rotation": [0.1825742, 0.3651484, 0.5477226, 0.7302967],
+         "scale": [0.5, 2, 1.5], "children": [2, 3]},
+        {"name": "a", "mesh": 0, "matrix": [0,1,0,0, -1,0,0,0, 0,0,1,0, 0.125,4.5,-2,1]},
+        {"name": "b", "mesh": 0, "translation": [-6, 0.75, 3], "rotation": [0, 0.7071068, 0, 0.7071068]})";
+    Doc nearDoc, farDoc;
+    nearDoc.nodes = R"([{"name": "root", "children": [1]},)" + children + "]";
+    const glm::dvec3 offset(1e7, -3e6, 2.5e7);
+    farDoc.nodes = R"([{"name": "root", "translation": [1e7, -3e6, 2.5e7], "children": [1]},)" + children + "]";
+    std::filesystem::path path;
+    auto near = load(dir, nearDoc, path);
+    ASSERT_TRUE(near.ok()) << near.error().message;
+    EXPECT_EQ(near->origin, glm::dvec3(0.0));  // close to the origin: no recentring
+    auto far = load(dir, farDoc, path);
+    ASSERT_TRUE(far.ok()) << far.error().message;
+    EXPECT_GT(glm::length(far->origin), 1e7);
+    // Float round-off of values of size ~10 only (composing in float left errors of ~1 unit).
+    expectSamePlacement(*near, *far, offset, 1e-5);
+}
+
+// Index just past the JSON value (array/object) that opens at `open`; strings respected.
+std::size_t endOfValue(const std::string& s, std::size_t open) {
+    int depth = 0;
+    bool inString = false;
+    for (std::size_t i = open; i < s.size(); ++i) {
+        const char c = s[i];
+        if (inString) {
+            if (c == '\\') ++i;
+            else if (c == '"') inString = false;
+        } else if (c == '"') {
+            inString = true;
+        } else if (c == '[' || c == '{') {
+            ++depth;
+        } else if ((c == ']' || c == '}') && --depth == 0) {
+            return i + 1;
+        }
+    }
+    return std::string::npos;
+}
+
+// Number of top-level elements of the array opening at `open`.
+std::size_t arrayLength(const std::string& s, std::size_t open) {
+    std::size_t n = 0;
+    for (std::size_t i = open + 1; i < s.size();) {
+        while (i < s.size() && (s[i] == ' ' || s[i] == '\n' || s[i] == '\r' || s[i] == '\t' || s[i] == ',')) ++i;
+        if (s[i] == ']') return n;
+        ++n;
+        i = s[i] == '{' || s[i] == '[' ? endOfValue(s, i) : s.find_first_of(",]", i);
+    }
+    return n;
+}
+
+// The real 2CylinderEngine (skipped when ../shared/data is absent) under a root moved by
+// 1e7: the loader's placements must match the original's to float round-off of the
+// model's own size (composed in float they were off by up to a unit, 3% of the pixels).
+TEST(GltfPrecision, TwoCylinderEngineAt1e7MatchesTheOriginal) {
+    std::filesystem::path data = DYNCULL_SHARED_DATA_DIR;
+    if (const char* env = std::getenv("DYNCULL_DATA"); env && *env) data = env;
+    const auto original = data / "2CylinderEngine.gltf";
+    if (!std::filesystem::exists(original) || !std::filesystem::exists(data / "2CylinderEngine0.bin"))
+        GTEST_SKIP() << original << " not available";
+    std::stringstream ss;
+    ss << std::ifstream(original).rdbuf();
+    std::string json = ss.str();
+    // scenes[0].nodes -> [new root]; the new root (appended to "nodes") holds the old roots.
+    const std::size_t scenes = json.find("\"scenes\"");
+    const std::size_t rootsOpen = json.find('[', json.find("\"nodes\"", scenes));
+    const std::size_t rootsEnd = endOfValue(json, rootsOpen);
+    const std::string oldRoots = json.substr(rootsOpen + 1, rootsEnd - rootsOpen - 2);
+    const std::size_t nodesOpen = json.find('[', json.find("\"nodes\"", rootsEnd));
+    const std::size_t newRoot = arrayLength(json, nodesOpen);
+    const std::size_t nodesEnd = endOfValue(json, nodesOpen);
+    ASSERT_NE(nodesEnd, std::string::npos);
+    json.insert(nodesEnd - 1, R"(, {"name": "far", "translation": [1e7, 0, 0], "children": [)" + oldRoots + "]}");
+    json.replace(rootsOpen + 1, rootsEnd - rootsOpen - 2, std::to_string(newRoot));
+
+    TempDir dir;
+    std::filesystem::create_symlink(data / "2CylinderEngine0.bin", dir.file("2CylinderEngine0.bin"));
+    const auto farPath = dir.write("far.gltf", json);
+    auto near = loadGltf(original);
+    ASSERT_TRUE(near.ok()) << near.error().message;
+    auto far = loadGltf(farPath);
+    ASSERT_TRUE(far.ok()) << far.error().message;
+    EXPECT_EQ(near->origin, glm::dvec3(0.0));
+    EXPECT_GT(far->origin.x, 1e7 - 1e4);
+    const double radius = 0.5 * static_cast<double>(glm::length(near->worldBounds().extent()));
+    RecordProperty("radius", static_cast<int>(radius));
+    expectSamePlacement(*near, *far, glm::dvec3(1e7, 0, 0), std::max(1e-6, 1e-6 * radius));
+}
+
+// ---- 6. degenerate node matrices ----------------------------------------------------
+
+TEST(GltfHostile, NonAffineNodeMatrixIsRejected) {
+    TempDir dir;
+    for (const char* bottom : {"0,0,0,0", "0,0,0,2", "0.001,0,0,1", "0,0,-1e-6,1"}) {
+        SCOPED_TRACE(bottom);
+        Doc d;
+        // glTF is column-major: the bottom row is element 3 of each column.
+        const std::string m = bottom;
+        std::vector<std::string> v;
+        for (std::size_t s = 0, e; s <= m.size(); s = e + 1) {
+            e = m.find(',', s);
+            if (e == std::string::npos) e = m.size();
+            v.push_back(m.substr(s, e - s));
+        }
+        d.nodes = R"([{"name": "proj", "mesh": 0, "matrix": [1,0,0,)" + v[0] + ", 0,1,0," + v[1] + ", 0,0,1," + v[2] +
+                  ", 5,6,7," + v[3] + "]}]";
+        std::filesystem::path path;
+        expectError(load(dir, d, path), path, "node 0 ('proj'): matrix is not affine");
+    }
+    Doc wrongSize;
+    wrongSize.nodes = R"([{"name": "short", "mesh": 0, "matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0]}])";
+    std::filesystem::path path;
+    expectError(load(dir, wrongSize, path), path, "node 0 ('short'): matrix has 15 elements, expected 16");
+    wrongSize.nodes = R"([{"mesh": 0, "translation": [1, 2]}])";
+    expectError(load(dir, wrongSize, path), path, "node 0: translation has 2 elements, expected 3");
+}
+
+TEST(GltfHostile, WorldCoordinatesBeyondRangeAreRejected) {
+    TempDir dir;
+    std::filesystem::path path;
+    const struct {
+        const char* nodes;
+        const char* expect;  // nullptr: loads
+    } cases[] = {
+        {R"([{"name": "huge", "scale": [1e30, 1e30, 1e30], "children": [1]}, {"name": "t", "mesh": 0}])",
+         "node 1 ('t'): places mesh 'm' beyond the accepted world range"},
+        {R"([{"name": "far", "translation": [0, 2e15, 0], "mesh": 0}])", "node 0 ('far'): places mesh 'm' beyond"},
+        {R"([{"name": "inf", "translation": [0, 1e400, 0], "mesh": 0}])", "1e400"},  // the JSON parser refuses it
+        {R"([{"name": "nan", "scale": [1e300, 1e300, 1e300], "children": [1]}, {"scale": [1e300, 0, 1], "mesh": 0}])",
+         "node 1"},
+        {R"([{"name": "tiny", "scale": [1e-30, 1e-30, 1e-30], "mesh": 0}])", "node 0 ('tiny'): transform matrix is singular"},
+        {R"([{"name": "big", "translation": [9e14, 0, 0], "mesh": 0}])", nullptr},
+        {R"([{"name": "bigscale", "scale": [1e14, 1e14, 1e14], "mesh": 0}])", nullptr},
+    };
+    for (const auto& c : cases) {
+        SCOPED_TRACE(c.nodes);
+        Doc d;
+        d.nodes = c.nodes;
+        auto r = load(dir, d, path);
+        if (c.expect) expectError(r, path, c.expect);
+        else EXPECT_TRUE(r.ok()) << r.error().message;
+    }
 }
 
 }  // namespace
