@@ -104,6 +104,11 @@ bool bufferFileExists(const std::string& filepath, void*) {
 }
 
 bool readBufferFile(std::vector<unsigned char>* out, std::string* err, const std::string& filepath, void*) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(filepath, ec)) {
+        if (err) *err += "not a regular file (a directory, device or pipe)";  // tinygltf has named the path
+        return false;
+    }
     std::string bytes;
     if (Status s = detail::readWholeFile(filepath, bytes); !s) {
         if (err) *err += s.message();
