@@ -38,6 +38,9 @@ void runInspect(const InspectOptions& o) {
     if (!scene) fail(scene.error().message);
     std::printf("%s: %zu meshes, %zu instances, loaded in %.1f ms\n", o.file.c_str(), scene->meshes.size(),
                 scene->instances.size(), sw.lap());
+    if (scene->origin != glm::dvec3(0.0))
+        std::printf("instances are relative to the scene origin (%.17g, %.17g, %.17g)\n", scene->origin.x,
+                    scene->origin.y, scene->origin.z);
     std::printf("%-4s %-28s %10s %10s %7s %7s %6s %9s\n", "mesh", "name", "tris", "tris_after", "added%", "leaves",
                 "depth", "build_ms");
     std::size_t before = 0, after = 0, leaves = 0;

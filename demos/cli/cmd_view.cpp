@@ -59,6 +59,9 @@ void runView(const ViewOptions& o) {
     std::printf("loaded %s: %zu instances, %zu meshes, %zu unique triangles, %zu instanced triangles\n",
                 o.file.c_str(), scene.instances.size(), scene.meshes.size(), scene.uniqueTriangleCount(),
                 scene.instancedTriangleCount());
+    if (scene.origin != glm::dvec3(0.0))
+        std::printf("instances are relative to the scene origin (%.17g, %.17g, %.17g)\n", scene.origin.x, scene.origin.y,
+                    scene.origin.z);
 
     ContextOptions co;
     co.kind = o.window ? ContextKind::GlfwWindow : ContextKind::HeadlessEgl;

@@ -43,6 +43,7 @@ TEST(SharedData, TwoCylinderEngineGltf) {
     EXPECT_EQ(r->meshes.size(), 29u);
     EXPECT_EQ(r->instancedTriangleCount(), 121496u);
     EXPECT_EQ(r->uniqueTriangleCount(), 75730u);
+    EXPECT_EQ(r->origin, glm::dvec3(0.0));  // near its file's origin: instances keep file coordinates
 }
 
 TEST(SharedData, SponzaGltf) {
@@ -52,6 +53,7 @@ TEST(SharedData, SponzaGltf) {
     ASSERT_TRUE(r.ok()) << r.error().message;
     EXPECT_EQ(r->instances.size(), 34u);
     EXPECT_EQ(r->instancedTriangleCount(), 66454u);
+    EXPECT_EQ(r->origin, glm::dvec3(0.0));
 }
 
 }  // namespace

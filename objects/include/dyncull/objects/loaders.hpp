@@ -38,10 +38,15 @@ Expected<Scene> loadObj(const std::filesystem::path& path);
 /// glTF 2.0, .gltf (external or base64 buffers) or .glb. Walks the default scene (or
 /// scene 0, or all root nodes when there is no scene): every node with a mesh becomes
 /// an Instance whose transform is the node's world matrix (object -> world, glTF units,
-/// usually metres). Each glTF mesh used is loaded once into one dyncull Mesh (its
-/// triangle, strip and fan primitives merged) and shared by all nodes using it; point
-/// and line primitives are skipped. Sparse accessors, node cycles and nodes whose world
-/// matrix is non-finite or singular are reported as an Error. Images are not decoded.
+/// usually metres), composed in double and stored relative to Scene::origin (non-zero
+/// only for scenes far from the file's origin). Each glTF mesh used is loaded once into
+/// one dyncull Mesh (its triangle, strip and fan primitives merged) and shared by all
+/// nodes using it; point and line primitives are skipped. Reported as an Error: sparse
+/// accessors, offsets/lengths/strides/counts outside their buffer, JSON nested deeper
+/// than 64, GLB versions other than 2, unsupported required extensions (Draco included),
+/// buffer URIs that are not regular files, node cycles, non-affine node matrices, and
+/// nodes whose world matrix is non-finite or singular or places a mesh beyond
+/// |coordinate| 1e15. Images are not decoded.
 Expected<Scene> loadGltf(const std::filesystem::path& path);
 
 }  // namespace dyncull
