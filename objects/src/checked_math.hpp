@@ -2,6 +2,7 @@
 // files: a corrupt header value must fail a check, never wrap into a small number.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <type_traits>
 
@@ -25,17 +26,25 @@ std::optional<T> checkedMul(T a, T b) {
     return r;
 }
 
-/// Bool form for call sites that keep the result in a variable they already have.
+/// Bool form for call sites that keep the result in a variable they already have:
+/// `out = a + b`, false (and `out` unspecified) when the sum does not fit in T.
 template <class T>
-bool checkedAdd(T a, T b, T& out) {
+[[nodiscard]] bool checkedAdd(T a, T b, T& out) {
     static_assert(std::is_integral_v<T>);
     return !__builtin_add_overflow(a, b, &out);
 }
 
+/// `out = a * b`, like checkedAdd.
 template <class T>
-bool checkedMul(T a, T b, T& out) {
+[[nodiscard]] bool checkedMul(T a, T b, T& out) {
     static_assert(std::is_integral_v<T>);
     return !__builtin_mul_overflow(a, b, &out);
+}
+
+/// True when bytes [offset, offset + length) lie inside a range of `size` bytes, without
+/// computing offset + length (which may wrap).
+constexpr bool rangeInside(std::uint64_t offset, std::uint64_t length, std::uint64_t size) {
+    return offset <= size && length <= size - offset;
 }
 
 }  // namespace dyncull::detail

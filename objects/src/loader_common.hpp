@@ -11,6 +11,7 @@
 #include <system_error>
 #include <type_traits>
 
+#include "checked_math.hpp"
 #include "dyncull/objects/error.hpp"
 #include "dyncull/objects/mesh.hpp"
 
@@ -23,34 +24,6 @@ inline Error fileError(const std::filesystem::path& path, const std::string& wha
         if (c == '\n' || c == '\r') c = ' ';
     while (!msg.empty() && msg.back() == ' ') msg.pop_back();
     return Error{std::move(msg)};
-}
-
-/// `out = a + b` for counts, offsets and lengths read from a file; false (and `out`
-/// untouched) when the sum does not fit in T. Every such computation goes through these,
-/// since a file can hold any value up to 2^64 - 1.
-template <class T>
-[[nodiscard]] inline bool checkedAdd(T a, T b, T& out) {
-    static_assert(std::is_unsigned_v<T>, "sizes are unsigned");
-    T r;
-    if (__builtin_add_overflow(a, b, &r)) return false;
-    out = r;
-    return true;
-}
-
-/// `out = a * b`, like checkedAdd.
-template <class T>
-[[nodiscard]] inline bool checkedMul(T a, T b, T& out) {
-    static_assert(std::is_unsigned_v<T>, "sizes are unsigned");
-    T r;
-    if (__builtin_mul_overflow(a, b, &r)) return false;
-    out = r;
-    return true;
-}
-
-/// True when bytes [offset, offset + length) lie inside a range of `size` bytes, without
-/// computing offset + length (which may wrap).
-constexpr bool rangeInside(std::uint64_t offset, std::uint64_t length, std::uint64_t size) {
-    return offset <= size && length <= size - offset;
 }
 
 /// Checks that `path` names a non-empty regular file (the common failures every loader
