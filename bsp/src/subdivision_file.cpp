@@ -10,6 +10,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "dyncull/objects/checked_write.hpp"
 #include "dyncull/objects/checksum.hpp"
 
 namespace dyncull {
@@ -158,6 +159,8 @@ Status writeSubdivisionFile(const std::filesystem::path& path, const SubdividedM
         f.seekp(0);
         f.write(h, sizeof h);
         if (!f) return bad(tmp, "write failed (disk full?)");
+        // The close flushes the last buffer: a full disk may show only here.
+        if (Status s = closeChecked(f, tmp); !s) return Error{"subdivision file " + s.message()};
     }
     std::error_code ec;
     std::filesystem::rename(tmp, path, ec);

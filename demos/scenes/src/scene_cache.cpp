@@ -7,7 +7,10 @@
 #include <fstream>
 #include <string>
 #include <type_traits>
+#include <string_view>
 #include <vector>
+
+#include "dyncull/objects/checked_write.hpp"
 
 namespace dyncull {
 namespace {
@@ -177,12 +180,8 @@ Status writeSceneCache(const std::filesystem::path& path, const PreparedScene& s
 
     std::filesystem::path tmp = path;
     tmp += ".tmp";
-    {
-        std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-        if (!f) return Error{"scene cache " + tmp.string() + ": cannot write"};
-        f.write(buf.data(), static_cast<std::streamsize>(buf.size()));
-        if (!f) return Error{"scene cache " + tmp.string() + ": write failed (disk full?)"};
-    }
+    if (Status s = writeFileChecked(tmp, std::string_view(buf.data(), buf.size())); !s)
+        return Error{"scene cache " + s.message()};
     std::error_code ec;
     std::filesystem::rename(tmp, path, ec);
     if (ec) return Error{"scene cache " + path.string() + ": cannot rename into place: " + ec.message()};
