@@ -13,6 +13,7 @@
 #include <vector>
 
 #include <glm/gtc/quaternion.hpp>
+#include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
 #include "dyncull/objects/loaders.hpp"
@@ -393,6 +394,35 @@ constexpr double kMaxWorldCoordinate = 1e15;
 // translations lose more than ~1e-6 of the scene's size.
 constexpr double kRecentreRatio = 16.0;
 
+// tinygltf reads an optional size field that is not a whole number in 0..2^64-1 (2^64 and
+// above, negative, fractional) as absent, i.e. 0: a wrong model rather than an error.
+// Check the raw JSON's offsets, lengths, strides and counts first (the depth check above
+// keeps this parse's recursion bounded).
+std::optional<Fail> checkSizeFields(std::string_view json) {
+    const nlohmann::json doc = nlohmann::json::parse(json.begin(), json.end(), nullptr, false);
+    if (doc.is_discarded() || !doc.is_object()) return std::nullopt;  // tinygltf reports the syntax error
+    struct Fields {
+        const char* array;
+        std::initializer_list<const char*> names;
+    };
+    for (const Fields& f : {Fields{"buffers", {"byteLength"}}, Fields{"bufferViews", {"buffer", "byteOffset", "byteLength", "byteStride"}},
+                            Fields{"accessors", {"bufferView", "byteOffset", "count"}}}) {
+        const auto arr = doc.find(f.array);
+        if (arr == doc.end() || !arr->is_array()) continue;
+        for (std::size_t i = 0; i < arr->size(); ++i) {
+            const nlohmann::json& item = (*arr)[i];
+            if (!item.is_object()) continue;
+            for (const char* name : f.names) {
+                const auto v = item.find(name);
+                if (v != item.end() && !v->is_number_unsigned())
+                    return Fail{std::string(f.array) + "[" + std::to_string(i) + "]." + name + " is " + v->dump() +
+                                ", not a whole number in 0..2^64-1"};
+            }
+        }
+    }
+    return std::nullopt;
+}
+
 struct PendingInstance {
     std::uint32_t mesh;
     glm::dmat4 world;
@@ -413,6 +443,8 @@ Expected<Scene> loadGltfImpl(const std::filesystem::path& path) {
     if (jsonNestsDeeperThan(json, kMaxJsonDepth))
         return detail::fileError(path, "JSON nests deeper than " + std::to_string(kMaxJsonDepth) +
                                            " levels (glTF needs fewer than 10)");
+
+    if (auto f = checkSizeFields(json)) return detail::fileError(path, f->what);
 
     tinygltf::TinyGLTF loader;
     loader.SetImageLoader(ignoreImage, nullptr);
