@@ -23,39 +23,10 @@ namespace {
 
 using test::put;
 using test::TempDir;
+using test::expectError;
+using test::base64;
 
 constexpr const char* k2to64minus1 = "18446744073709551615";
-
-void expectError(const Expected<Scene>& r, const std::filesystem::path& path, const std::string& what) {
-    ASSERT_FALSE(r.ok()) << "expected an error containing '" << what << "'";
-    const std::string& msg = r.error().message;
-    EXPECT_EQ(msg.rfind(path.string(), 0), 0u) << msg;
-    EXPECT_NE(msg.find(what), std::string::npos) << "expected '" << what << "' in: " << msg;
-    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
-}
-
-std::string base64(const std::string& in) {
-    static const char* tbl = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    std::string out;
-    std::size_t i = 0;
-    for (; i + 2 < in.size(); i += 3) {
-        const std::uint32_t v = (std::uint8_t(in[i]) << 16) | (std::uint8_t(in[i + 1]) << 8) | std::uint8_t(in[i + 2]);
-        for (int k = 3; k >= 0; --k) out += tbl[(v >> (6 * k)) & 63];
-    }
-    if (i + 1 == in.size()) {
-        const std::uint32_t v = std::uint8_t(in[i]) << 16;
-        out += tbl[(v >> 18) & 63];
-        out += tbl[(v >> 12) & 63];
-        out += "==";
-    } else if (i + 2 == in.size()) {
-        const std::uint32_t v = (std::uint8_t(in[i]) << 16) | (std::uint8_t(in[i + 1]) << 8);
-        out += tbl[(v >> 18) & 63];
-        out += tbl[(v >> 12) & 63];
-        out += tbl[(v >> 6) & 63];
-        out += '=';
-    }
-    return out;
-}
 
 // 44 bytes: a triangle (0,0,0) (1,0,0) (0,1,0) as float VEC3, uint16 indices 0 1 2, 2 bytes padding.
 std::string triangleBytes() {

@@ -11,13 +11,7 @@ namespace dyncull {
 namespace {
 
 using test::TempDir;
-
-void expectError(const Expected<Scene>& r, const std::filesystem::path& path, const std::string& what) {
-    ASSERT_FALSE(r.ok());
-    const std::string& msg = r.error().message;
-    EXPECT_EQ(msg.rfind(path.string(), 0), 0u) << msg;
-    EXPECT_NE(msg.find(what), std::string::npos) << "expected '" << what << "' in: " << msg;
-}
+using test::expectError;
 
 // Two shapes: a quad (shared corners referenced twice) and a pentagon with normals.
 const char* kObj =

@@ -11,15 +11,7 @@ namespace {
 
 using test::put;
 using test::TempDir;
-
-// The error message must start with the path and mention `what`.
-void expectError(const Expected<Scene>& r, const std::filesystem::path& path, const std::string& what) {
-    ASSERT_FALSE(r.ok());
-    const std::string& msg = r.error().message;
-    EXPECT_EQ(msg.rfind(path.string(), 0), 0u) << msg;
-    EXPECT_NE(msg.find(what), std::string::npos) << "expected '" << what << "' in: " << msg;
-    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
-}
+using test::expectError;
 
 // Unit square in z = 0 as one quad plus a triangle above it, with Stanford-style extras.
 const char* kAsciiQuad =

@@ -13,6 +13,9 @@
 
 #include <gtest/gtest.h>
 
+#include "dyncull/objects/error.hpp"
+#include "dyncull/objects/scene.hpp"
+
 namespace dyncull::test {
 
 /// Unique directory under the system temp dir, removed with its files on destruction.
@@ -68,6 +71,39 @@ void put(std::string& out, T v, bool bigEndian) {
     if (bigEndian)
         for (std::size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(b[i], b[sizeof(T) - 1 - i]);
     out.append(reinterpret_cast<const char*>(b), sizeof(T));
+}
+
+/// A loader's error: one line that starts with the file's path and mentions `what`.
+inline void expectError(const Expected<Scene>& r, const std::filesystem::path& path, const std::string& what) {
+    ASSERT_FALSE(r.ok()) << "expected an error containing '" << what << "'";
+    const std::string& msg = r.error().message;
+    EXPECT_EQ(msg.rfind(path.string(), 0), 0u) << msg;
+    EXPECT_NE(msg.find(what), std::string::npos) << "expected '" << what << "' in: " << msg;
+    EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+}
+
+/// Standard base64 with padding (glTF data URIs).
+inline std::string base64(const std::string& in) {
+    static const char* tbl = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    std::size_t i = 0;
+    for (; i + 2 < in.size(); i += 3) {
+        const std::uint32_t v = (std::uint8_t(in[i]) << 16) | (std::uint8_t(in[i + 1]) << 8) | std::uint8_t(in[i + 2]);
+        for (int k = 3; k >= 0; --k) out += tbl[(v >> (6 * k)) & 63];
+    }
+    if (i + 1 == in.size()) {
+        const std::uint32_t v = std::uint8_t(in[i]) << 16;
+        out += tbl[(v >> 18) & 63];
+        out += tbl[(v >> 12) & 63];
+        out += "==";
+    } else if (i + 2 == in.size()) {
+        const std::uint32_t v = (std::uint8_t(in[i]) << 16) | (std::uint8_t(in[i + 1]) << 8);
+        out += tbl[(v >> 18) & 63];
+        out += tbl[(v >> 12) & 63];
+        out += tbl[(v >> 6) & 63];
+        out += '=';
+    }
+    return out;
 }
 
 }  // namespace dyncull::test
