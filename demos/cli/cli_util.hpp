@@ -2,10 +2,9 @@
 #pragma once
 
 #include <chrono>
+#include <cstdint>
 #include <filesystem>
 #include <string>
-
-#include <cstdint>
 
 #include <CLI/CLI.hpp>
 #include <glm/glm.hpp>

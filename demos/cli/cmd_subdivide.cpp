@@ -9,8 +9,6 @@
 #include <memory>
 #include <string>
 
-#include <limits>
-
 #include "cli_util.hpp"
 #include "commands.hpp"
 #include "dyncull/bsp/subdivision_file.hpp"
@@ -116,22 +114,7 @@ void registerSubdivide(CLI::App& app) {
     cmd->add_option("--threads", s.threads, "worker threads (the result does not depend on it)")
         ->check(wholeIn(1, kMaxThreads))
         ->capture_default_str();
-    cmd->add_option("--plant-seed", o->sceneOptions.plant.seed, "powerplant: generator seed")
-        ->check(wholeIn(0, std::numeric_limits<std::uint64_t>::max()))
-        ->capture_default_str();
-    cmd->add_option("--plant-size", o->sceneOptions.plant.size, "powerplant: fraction of the objects, (0, 1]")
-        ->check(realIn(0.0, 1.0, true))
-        ->capture_default_str();
-    cmd->add_option("--plant-detail", o->sceneOptions.plant.detail, "powerplant: tessellation factor, (0, 1]")
-        ->check(realIn(0.0, 1.0, true))
-        ->capture_default_str();
-    cmd->add_option("--city-seed", o->sceneOptions.city.seed, "city: generator seed")
-        ->check(wholeIn(0, std::numeric_limits<std::uint64_t>::max()))
-        ->capture_default_str();
-    cmd->add_option_function<std::uint32_t>(
-        "--city-blocks", [o](const std::uint32_t& n) { o->sceneOptions.city.blocksX = o->sceneOptions.city.blocksZ = n; },
-        "city: blocks along each axis (default 20, at most 100)")
-        ->check(wholeIn(1, 100));
+    addGeneratorOptions(*cmd, o->sceneOptions);
     cmd->callback([o] { runSubdivide(*o); });
 }
 

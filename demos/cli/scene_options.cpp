@@ -1,7 +1,5 @@
 #include "scene_options.hpp"
 
-#include <limits>
-
 namespace dyncull::cli {
 
 void addBunnyOptions(CLI::App& cmd, BunnySwarmOptions& o) {
@@ -19,7 +17,7 @@ void addBunnyOptions(CLI::App& cmd, BunnySwarmOptions& o) {
         ->capture_default_str();
     cmd.add_option("--speed", o.speed, "bunnies: speed in world units per frame")->check(realIn(0.0, 1e4))->capture_default_str();
     cmd.add_option("--seed", o.seed, "bunnies: seed of start positions, velocities and orientations")
-        ->check(wholeIn(0, std::numeric_limits<std::uint64_t>::max()))
+        ->check(wholeIn(0, kMaxSeed))
         ->capture_default_str();
     cmd.add_option("--orbit", o.orbit, "bunnies: orbit the box at this distance instead of the default flight")
         ->check(realIn(0.0, 1e7, true));
@@ -50,22 +48,26 @@ void addMeasureOptions(CLI::App& cmd, MeasureOptions& o, std::string& size, cons
     addGeneratedSceneOptions(cmd, o.sceneOptions);
 }
 
-void addGeneratedSceneOptions(CLI::App& cmd, SceneOptions& o) {
-    cmd.add_option("--scene-dir", o.sceneDir, "powerplant: load every .ply/.obj under this directory instead of generating");
-    cmd.add_option("--cache-dir", o.cache.dir, "powerplant/city: cache directory (default $DYNCULL_CACHE, else out/cache)");
-    cmd.add_flag("--no-cache", [&o](std::int64_t) { o.cache.enabled = false; }, "powerplant/city: always regenerate, never cache");
-    cmd.add_option("--plant-seed", o.plant.seed, "powerplant: generator seed")->check(wholeIn(0, std::numeric_limits<std::uint64_t>::max()))->capture_default_str();
+void addGeneratorOptions(CLI::App& cmd, SceneOptions& o) {
+    cmd.add_option("--plant-seed", o.plant.seed, "powerplant: generator seed")->check(wholeIn(0, kMaxSeed))->capture_default_str();
     cmd.add_option("--plant-size", o.plant.size, "powerplant: fraction of the objects, (0, 1]")
         ->check(realIn(0.0, 1.0, true))
         ->capture_default_str();
     cmd.add_option("--plant-detail", o.plant.detail, "powerplant: tessellation factor, (0, 1]")
         ->check(realIn(0.0, 1.0, true))
         ->capture_default_str();
-    cmd.add_option("--city-seed", o.city.seed, "city: generator seed")->check(wholeIn(0, std::numeric_limits<std::uint64_t>::max()))->capture_default_str();
+    cmd.add_option("--city-seed", o.city.seed, "city: generator seed")->check(wholeIn(0, kMaxSeed))->capture_default_str();
     cmd.add_option_function<std::uint32_t>(
         "--city-blocks", [&o](const std::uint32_t& n) { o.city.blocksX = o.city.blocksZ = n; },
         "city: blocks along each axis (default 20, at most 100)")
         ->check(wholeIn(1, 100));
+}
+
+void addGeneratedSceneOptions(CLI::App& cmd, SceneOptions& o) {
+    cmd.add_option("--scene-dir", o.sceneDir, "powerplant: load every .ply/.obj under this directory instead of generating");
+    cmd.add_option("--cache-dir", o.cache.dir, "powerplant/city: cache directory (default $DYNCULL_CACHE, else out/cache)");
+    cmd.add_flag("--no-cache", [&o](std::int64_t) { o.cache.enabled = false; }, "powerplant/city: always regenerate, never cache");
+    addGeneratorOptions(cmd, o);
     cmd.add_option_function<unsigned>(
         "--threads", [&o](const unsigned& n) { o.plant.threads = o.city.threads = o.subdivide.threads = n; },
         "powerplant/city: threads for the local BSP builds and --subdivide (default 2)")

@@ -2,6 +2,7 @@
 // parameters and the scheduler's switches, registered on a CLI11 subcommand.
 #pragma once
 
+#include <limits>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -20,10 +21,15 @@ inline constexpr std::uint64_t kMaxFrames = 10'000'000;        ///< a day of 10 
 inline constexpr std::uint64_t kMaxBunnies = 100'000;          ///< ~350 bytes of scene state each
 inline constexpr std::uint64_t kMaxTriangleCount = 100'000'000;  ///< per leaf limits
 inline constexpr std::uint64_t kMaxThreads = 256;
+inline constexpr std::uint64_t kMaxSeed = std::numeric_limits<std::uint64_t>::max();  ///< any 64-bit seed
 
 
 /// Adds --count --box --bunny-size --speed --seed --orbit --mesh --assets --path-frames.
 void addBunnyOptions(CLI::App& cmd, BunnySwarmOptions& o);
+
+/// The power plant and city generators' options (seed, size, detail, blocks), shared by
+/// `run`/`bench`/`sweep` (through addGeneratedSceneOptions) and `subdivide`.
+void addGeneratorOptions(CLI::App& cmd, SceneOptions& o);
 
 /// Adds the generated-scene options (power plant, city, directory scenes, cache):
 /// --scene-dir --cache-dir --no-cache --plant-seed --plant-size --plant-detail --city-seed

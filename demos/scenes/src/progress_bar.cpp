@@ -13,12 +13,6 @@ ProgressBar::ProgressBar(std::string label, double total, std::FILE* out)
     draw(true);
 }
 
-void ProgressBar::advance(double amount) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    done_ = std::min(total_, done_ + amount);
-    draw(false);
-}
-
 void ProgressBar::advance(double amount, std::string note) {
     std::lock_guard<std::mutex> lock(mutex_);
     note_ = std::move(note);
@@ -46,7 +40,7 @@ void ProgressBar::finish() {
     std::lock_guard<std::mutex> lock(mutex_);
     if (finished_) return;
     // The last advance may have drawn the finished state already: do not repeat it.
-    if (done_ < total_ || lastDrawnDone_ < total_) {
+    if (lastDrawnDone_ < total_) {
         done_ = total_;
         draw(true);
     }

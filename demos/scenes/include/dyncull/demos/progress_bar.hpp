@@ -18,10 +18,9 @@ public:
     ProgressBar(const ProgressBar&) = delete;
     ProgressBar& operator=(const ProgressBar&) = delete;
 
-    /// Adds `amount` units of work done (any thread).
-    void advance(double amount);
-    /// Adds `amount` and sets a short note shown after the ETA (e.g. "2495 ms/frame").
-    void advance(double amount, std::string note);
+    /// Adds `amount` units of work done (any thread) and sets the short note shown after
+    /// the ETA (e.g. "2495 ms/frame"; empty: none).
+    void advance(double amount, std::string note = {});
     /// Starts a new phase: new label and total, progress back to zero, same stream.
     void restart(std::string label, double total);
     /// Prints the final state once (also done by the destructor).
