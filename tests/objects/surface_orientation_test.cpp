@@ -392,17 +392,22 @@ TEST(SurfaceOrientation, StanfordBunnyIsOpenAndOutward) {
 #endif
 }
 
-TEST(SurfaceOrientation, NpmBunnyIsConsistentAndOutward) {
-    const auto path = dataFile("bunny_npm.ply");
+TEST(SurfaceOrientation, NpmBunnyIsClosedAndOutward) {
+    // scripts/setup.sh writes it to ./assets ($DYNCULL_ASSETS overrides, as for the demos).
+    std::filesystem::path path = DYNCULL_ASSETS_DIR "/bunny_npm.ply";
+    if (const char* env = std::getenv("DYNCULL_ASSETS"); env && *env) path = std::filesystem::path(env) / "bunny_npm.ply";
     if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not available";
     auto scene = loadScene(path);
     ASSERT_TRUE(scene.ok()) << scene.error().message;
     ASSERT_EQ(scene->meshes.size(), 1u);
     const SurfaceReport r = analyseSurface(scene->meshes[0]);
     EXPECT_EQ(r.triangles, 3674u);
+    EXPECT_TRUE(r.closed());  // unlike the Stanford scan, the npm bunny is watertight
     EXPECT_TRUE(r.consistent());
+    EXPECT_EQ(r.shells, 1u);
     EXPECT_GT(r.signedVolume, 0.0);
     EXPECT_EQ(r.flippedShells, 0u);
+    EXPECT_EQ(r.mode, FaceMode::CullBack);
 }
 
 }  // namespace
