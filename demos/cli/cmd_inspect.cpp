@@ -1,5 +1,6 @@
 // `dyncull inspect FILE`: builds the local BSP of every mesh in a file and prints, per
-// mesh, triangles before and after splitting, leaves, depth and build time.
+// mesh, triangles before and after splitting, leaves, depth and build time, and what the
+// surface analysis says about culling its back faces.
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -9,6 +10,7 @@
 #include "scene_options.hpp"
 #include "dyncull/bsp/local_bsp.hpp"
 #include "dyncull/objects/loaders.hpp"
+#include "dyncull/objects/surface_orientation.hpp"
 
 namespace dyncull::cli {
 namespace {
@@ -41,18 +43,21 @@ void runInspect(const InspectOptions& o) {
     if (scene->origin != glm::dvec3(0.0))
         std::printf("instances are relative to the scene origin (%.17g, %.17g, %.17g)\n", scene->origin.x,
                     scene->origin.y, scene->origin.z);
-    std::printf("%-4s %-28s %10s %10s %7s %7s %6s %9s\n", "mesh", "name", "tris", "tris_after", "added%", "leaves",
-                "depth", "build_ms");
-    std::size_t before = 0, after = 0, leaves = 0;
-    double ms = 0;
+    std::printf("%-4s %-28s %10s %10s %7s %7s %6s %9s %8s  %s\n", "mesh", "name", "tris", "tris_after", "added%",
+                "leaves", "depth", "build_ms", "surf_ms", "surface");
+    std::size_t before = 0, after = 0, leaves = 0, cullBack = 0;
+    double ms = 0, surfaceMs = 0;
     for (std::size_t i = 0; i < scene->meshes.size(); ++i) {
         const Mesh& m = scene->meshes[i];
         auto bsp = buildLocalBsp(m, p);
         if (!bsp) fail(o.file + ": mesh " + std::to_string(i) + ": " + bsp.error().message);
         const LocalBspStats& s = bsp->stats;
         const double added = s.trianglesBefore ? 100.0 * (double(s.trianglesAfter) / double(s.trianglesBefore) - 1.0) : 0.0;
-        std::printf("%-4zu %-28.28s %10zu %10zu %7.2f %7u %6u %9.2f\n", i, m.name.c_str(), s.trianglesBefore,
-                    s.trianglesAfter, added, s.leaves, s.depth, s.buildMs);
+        const SurfaceReport surface = analyseSurface(m);
+        std::printf("%-4zu %-28.28s %10zu %10zu %7.2f %7u %6u %9.2f %8.2f  %s\n", i, m.name.c_str(), s.trianglesBefore,
+                    s.trianglesAfter, added, s.leaves, s.depth, s.buildMs, surface.analyseMs, surface.summary().c_str());
+        cullBack += surface.mode == FaceMode::CullBack;
+        surfaceMs += surface.analyseMs;
         before += s.trianglesBefore;
         after += s.trianglesAfter;
         leaves += s.leaves;
@@ -60,6 +65,8 @@ void runInspect(const InspectOptions& o) {
     }
     std::printf("total: %zu triangles -> %zu (%+.2f%%), %zu leaves, %.1f ms building\n", before, after,
                 before ? 100.0 * (double(after) / double(before) - 1.0) : 0.0, leaves, ms);
+    std::printf("surfaces: %zu of %zu meshes may cull back faces, %zu two-sided; analysed in %.1f ms\n", cullBack,
+                scene->meshes.size(), scene->meshes.size() - cullBack, surfaceMs);
 }
 
 }  // namespace
