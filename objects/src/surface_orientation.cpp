@@ -181,9 +181,13 @@ double maxAbs(const glm::dvec3& v) { return std::max({std::abs(v.x), std::abs(v.
 /// Ray parity of `p` against the triangles `tris` (welded geometry in `mesh`): 1 inside,
 /// 0 outside, -1 undecided (the ray grazes an edge or vertex within tolerance, or `p` lies on
 /// the surface). Exact float inputs, differences in double (exact for coordinates within
-/// 2^29 of each other's magnitude), triple products with about 1e-15 relative error; the
-/// 1e-12 tolerance leaves a wide margin, so a decided answer is right for any shell that is
-/// not self-intersecting; near-misses are reported undecided rather than guessed.
+/// 2^29 of each other's magnitude; the query point, a centroid, is
+/// rounded once), triple products with about 1e-15 relative error; the
+/// 1e-12 tolerance leaves a wide margin, so a decided answer is right for a closed shell
+/// that does not intersect itself; near-misses are reported undecided rather than guessed.
+/// Limits: a self-intersecting container can give either parity; and the caller tests one
+/// point on the inner shell, so two shells that intersect each other (partly inside) get
+/// the answer of that point.
 int rayParity(const Mesh& mesh, const std::uint32_t* tris, std::size_t count, const glm::dvec3& p,
               const glm::dvec3& d, std::uint64_t& work) {
     constexpr double kTol = 1e-12;
@@ -401,11 +405,15 @@ Analysis analyse(const Mesh& mesh) {
                     undecided = true;
                     return;
                 }
-                // A few vertices of s, each with a few directions: the first decided answer wins.
+                // From the centroids of up to 4 triangles of s (not vertices: a cavity touching
+                // its container at a corner is common), 4 directions each: the first decided
+                // answer wins; none decided leaves s ambiguous (two-sided).
                 int answer = -1;
                 for (int vk = 0; vk < 4 && answer < 0; ++vk) {
-                    const std::uint32_t t = sTris[(sCount - 1) * std::size_t(vk) / 3];
-                    const glm::dvec3 p(mesh.positions[mesh.indices[3 * std::size_t(t)]]);
+                    const std::size_t t = 3 * std::size_t(sTris[(sCount - 1) * std::size_t(vk) / 3]);
+                    const glm::dvec3 p = (glm::dvec3(mesh.positions[mesh.indices[t]]) +
+                                          glm::dvec3(mesh.positions[mesh.indices[t + 1]]) +
+                                          glm::dvec3(mesh.positions[mesh.indices[t + 2]])) / 3.0;
                     for (int dk = 0; dk < 4 && answer < 0; ++dk)
                         answer = rayParity(mesh, shellTris.data() + shellStart[ti], shellStart[ti + 1] - shellStart[ti],
                                            p, glm::dvec3(kDirs[dk][0], kDirs[dk][1], kDirs[dk][2]), work);
