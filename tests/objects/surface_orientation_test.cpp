@@ -241,6 +241,26 @@ TEST(SurfaceOrientation, ManyCavitiesInsideOneShell) {
     EXPECT_NEAR(volumeOf(m, glm::dvec3(0.0), 12 + 12 * 1000, m.triangleCount()), 10.0, 1e-9);
 }
 
+TEST(SurfaceOrientation, MirroredExportWithThousandsOfShellsIsFlipped) {
+    // 10,000 separate inward cubes (a model exported through a mirroring transform): each is
+    // checked for containers through the box tree, not against every other shell, so the
+    // nesting budget (linear in the triangles) is not exhausted and every one is flipped.
+    Mesh m;
+    for (int i = 0; i < 10000; ++i)
+        addCube(m, glm::vec3(float(i % 25), float(i / 25 % 20), float(i / 500)) * 2.0f, 1.0f);
+    invertTriangles(m, 0, m.triangleCount());
+    const auto t0 = std::chrono::steady_clock::now();
+    const SurfaceReport r = orientAndRecheck(m);
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    EXPECT_EQ(r.shells, 10000u);
+    EXPECT_EQ(r.flippedShells, 10000u);
+    EXPECT_EQ(r.ambiguousShells, 0u);
+    EXPECT_EQ(r.mode, FaceMode::CullBack);
+    EXPECT_DOUBLE_EQ(r.signedVolume, 10000.0);
+    EXPECT_LT(ms, 5000.0);
+    RecordProperty("orient_ms", static_cast<int>(ms));
+}
+
 TEST(SurfaceOrientation, SeamDuplicatesAreWelded) {
     Mesh m = cube(2.0f, glm::vec3(-1.0f), /*perFace=*/true);
     ASSERT_EQ(m.positions.size(), 24u);
