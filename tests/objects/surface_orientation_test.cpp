@@ -4,7 +4,9 @@
 // orientSurface (nothing left to flip, same topology), and the real Stanford bunny.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 
