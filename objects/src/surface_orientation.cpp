@@ -4,6 +4,8 @@
 // and the nesting tests, which have a budget (kNestingBudget*).
 #include "dyncull/objects/surface_orientation.hpp"
 
+#include "vertex_weld.hpp"
+
 #include <algorithm>
 #include <bit>
 #include <cassert>
@@ -25,46 +27,6 @@ constexpr std::uint32_t kNone = 0xffffffffu;
 // linear; shells left undecided when it runs out count as ambiguous (two-sided).
 constexpr std::uint64_t kNestingBudgetPerTriangle = 32;
 constexpr std::uint64_t kNestingBudgetBase = 1u << 20;
-
-std::uint32_t floatBits(float f) {
-    return std::bit_cast<std::uint32_t>(f == 0.0f ? 0.0f : f);  // -0.0 and +0.0 are one position
-}
-
-std::uint32_t mix(std::uint32_t h) {  // murmur3 finaliser
-    h ^= h >> 16;
-    h *= 0x85ebca6bu;
-    h ^= h >> 13;
-    h *= 0xc2b2ae35u;
-    return h ^ (h >> 16);
-}
-
-/// Welded id per vertex (equal float bits after -0 -> +0), ids dense from 0. Open
-/// addressing over representative vertex indices: O(n) expected, no node allocations.
-std::vector<std::uint32_t> weldVertices(const std::vector<glm::vec3>& pos, std::size_t& weldedCount) {
-    std::size_t cap = 16;
-    while (cap < 2 * pos.size()) cap <<= 1;
-    std::vector<std::uint32_t> slots(cap, kNone);
-    std::vector<std::uint32_t> id(pos.size());
-    std::uint32_t next = 0;
-    for (std::uint32_t v = 0; v < pos.size(); ++v) {
-        const std::uint32_t x = floatBits(pos[v].x), y = floatBits(pos[v].y), z = floatBits(pos[v].z);
-        std::size_t s = mix(x ^ mix(y ^ mix(z))) & (cap - 1);
-        for (;; s = (s + 1) & (cap - 1)) {
-            const std::uint32_t r = slots[s];
-            if (r == kNone) {
-                slots[s] = v;
-                id[v] = next++;
-                break;
-            }
-            if (floatBits(pos[r].x) == x && floatBits(pos[r].y) == y && floatBits(pos[r].z) == z) {
-                id[v] = id[r];
-                break;
-            }
-        }
-    }
-    weldedCount = next;
-    return id;
-}
 
 std::uint32_t findRoot(std::vector<std::uint32_t>& parent, std::uint32_t x) {
     while (parent[x] != x) {
@@ -234,7 +196,7 @@ Analysis analyse(const Mesh& mesh) {
     r.triangles = triCount;
     // Edge entries pack (t << 1) and edge offsets are 32-bit: 3 * triangles must fit.
     if (triCount > 0xffffffffu / 3) throw std::length_error("analyseSurface: more than 1,431,655,765 triangles");
-    const std::vector<std::uint32_t> wid = weldVertices(mesh.positions, r.weldedVertices);
+    const std::vector<std::uint32_t> wid = detail::weldVertices(mesh.positions, r.weldedVertices);
 
     // Directed edges bucketed by their lower welded vertex (counting sort): entry =
     // (higher vertex << 32) | (triangle << 1) | (lower -> higher is the triangle's direction).
