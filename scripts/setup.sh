@@ -9,7 +9,7 @@ cd "$(dirname "$0")/.."
 PACKAGES=(
   build-essential cmake pkg-config git
   libglfw3-dev libglm-dev libegl-dev libgl-dev libepoxy-dev libegl-mesa0 libgl1-mesa-dri
-  libtinygltf-dev nlohmann-json3-dev libstb-dev libcli11-dev
+  libtinygltf-dev nlohmann-json3-dev libstb-dev libcli11-dev libmeshoptimizer-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth gnuplot-nox
 )

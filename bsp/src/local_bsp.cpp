@@ -175,15 +175,21 @@ Expected<LocalBsp> buildLocalBsp(const Mesh& mesh, const LocalBspParams& params)
     bsp.mesh.name = mesh.name;
     bsp.mesh.positions = mesh.positions;
     bsp.mesh.normals = mesh.normals;
-    if (bsp.mesh.normals.empty()) {
-        bsp.mesh.indices = mesh.indices;  // computeNormals needs the triangles
-        computeNormals(bsp.mesh);
+    bsp.mesh.indices = mesh.indices;
+    // Orientation is decided on the whole input surface: the split mesh has T-junctions
+    // where a plane cut one triangle but not its neighbour, which would read as holes.
+    if (params.faces != FacePolicy::TwoSided) {
+        const SurfaceReport surface = orientSurface(bsp.mesh);
+        bsp.faces = params.faces == FacePolicy::CullBack ? FaceMode::CullBack : surface.mode;
     }
+    if (bsp.mesh.normals.empty()) computeNormals(bsp.mesh);  // from the oriented triangles
     bsp.stats.trianglesBefore = mesh.triangleCount();
     {
+        const std::vector<std::uint32_t> input = std::move(bsp.mesh.indices);
         Builder builder(params, bsp);
-        builder.run(mesh.indices);
+        builder.run(input);
     }
+    if (params.optimizeOrder) optimizeLeafOrder(bsp);
     bsp.stats.trianglesAfter = bsp.mesh.triangleCount();
     bsp.volumes = buildNodeVolumes(bsp.mesh, bsp.nodes);
     bsp.stats.buildMs =

@@ -4,6 +4,7 @@
 // subdivision node with exactly one geometry node: here, one object with one part).
 #include <optional>
 
+#include "dyncull/bsp/local_bsp.hpp"
 #include "dyncull/bsp/subdivision.hpp"
 
 namespace dyncull {
@@ -21,7 +22,7 @@ void applyTriangleOrder(Mesh& mesh, Subdivision& sub) {
     std::vector<std::uint32_t>().swap(sub.triangles);
 }
 
-std::vector<LocalBsp> subdivisionLeafModels(const Mesh& mesh, const Subdivision& sub) {
+std::vector<LocalBsp> subdivisionLeafModels(const Mesh& mesh, const Subdivision& sub, FaceMode faces) {
     std::optional<Mesh> withNormals;
     if (mesh.normals.size() != mesh.positions.size()) {
         withNormals = mesh;
@@ -63,6 +64,8 @@ std::vector<LocalBsp> subdivisionLeafModels(const Mesh& mesh, const Subdivision&
         b.nodes.push_back(root);
         b.stats.trianglesBefore = b.stats.trianglesAfter = node.triangleCount;
         b.stats.leaves = 1;
+        b.faces = faces;
+        optimizeLeafOrder(b);
         out.push_back(std::move(b));
     }
     return out;

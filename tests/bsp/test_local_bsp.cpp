@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -245,6 +246,7 @@ TEST(LocalBsp, MeshBelowThresholdIsSingleLeaf) {
     const Mesh mesh = sphereMesh(16, 8);
     LocalBspParams p;
     p.maxLeafTriangles = std::uint32_t(mesh.triangleCount());
+    p.optimizeOrder = false;  // the triangles exactly as given (LeafOrder... tests the reordering)
     const LocalBsp bsp = buildOk(mesh, p);
     checkInvariants(bsp, p);
     EXPECT_FALSE(bsp.hasTree());
@@ -308,6 +310,82 @@ TEST(LocalBsp, BadInputIsAnError) {
     r = buildLocalBsp(good, p);
     ASSERT_FALSE(r.ok());
     EXPECT_NE(r.error().message.find("maxDepth"), std::string::npos);
+}
+
+// A closed cube, outward (counter-clockwise seen from outside), side 2 around the origin.
+Mesh cubeMesh(bool inward = false) {
+    Mesh m;
+    for (int i = 0; i < 8; ++i)
+        m.positions.push_back({(i & 1) ? 1.0f : -1.0f, (i & 2) ? 1.0f : -1.0f, (i & 4) ? 1.0f : -1.0f});
+    m.indices = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4,
+                 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
+    if (inward)
+        for (std::size_t t = 0; t < m.indices.size(); t += 3) std::swap(m.indices[t + 1], m.indices[t + 2]);
+    return m;
+}
+
+double signedVolume(const Mesh& m) {
+    double v = 0.0;
+    for (std::size_t t = 0; t < m.indices.size(); t += 3)
+        v += glm::dot(glm::dvec3(m.positions[m.indices[t]]),
+                      glm::cross(glm::dvec3(m.positions[m.indices[t + 1]]), glm::dvec3(m.positions[m.indices[t + 2]])));
+    return v / 6.0;
+}
+
+// Each node's triangles as a sorted list of (rotated so the smallest index leads) triples:
+// what must survive any reordering inside a leaf, winding included.
+std::vector<std::array<std::uint32_t, 3>> trianglesOf(const LocalBsp& bsp, const LocalBspNode& n) {
+    std::vector<std::array<std::uint32_t, 3>> out;
+    for (std::uint32_t k = n.firstIndex; k < n.firstIndex + n.indexCount; k += 3) {
+        std::array<std::uint32_t, 3> t{bsp.mesh.indices[k], bsp.mesh.indices[k + 1], bsp.mesh.indices[k + 2]};
+        std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+        out.push_back(t);
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+TEST(LocalBsp, LeafOrderKeepsEveryNodesTrianglesAndWinding) {
+    const Mesh sphere = sphereMesh(96, 64);
+    LocalBspParams p;
+    p.maxLeafTriangles = 1500;
+    p.optimizeOrder = false;
+    const LocalBsp loadOrder = buildOk(sphere, p);
+    p.optimizeOrder = true;
+    const LocalBsp ordered = buildOk(sphere, p);
+    checkInvariants(ordered, p);
+    ASSERT_EQ(ordered.nodes.size(), loadOrder.nodes.size());
+    ASSERT_GT(ordered.stats.leaves, 4u);
+    EXPECT_NE(ordered.mesh.indices, loadOrder.mesh.indices) << "nothing was reordered";
+    for (std::size_t i = 0; i < ordered.nodes.size(); ++i) {
+        ASSERT_EQ(ordered.nodes[i].firstIndex, loadOrder.nodes[i].firstIndex);
+        ASSERT_EQ(ordered.nodes[i].indexCount, loadOrder.nodes[i].indexCount);
+        EXPECT_EQ(trianglesOf(ordered, ordered.nodes[i]), trianglesOf(loadOrder, loadOrder.nodes[i])) << "node " << i;
+    }
+    EXPECT_EQ(ordered.mesh.positions, loadOrder.mesh.positions);
+}
+
+TEST(LocalBsp, FacePolicyDecidesTheFaceMode) {
+    LocalBspParams p;
+    p.maxLeafTriangles = 4;  // split the cube: orientation must be decided before splitting
+    EXPECT_EQ(buildOk(cubeMesh(), p).faces, FaceMode::CullBack);
+
+    // Inward: flipped before splitting, so every part of the split mesh faces outwards.
+    const LocalBsp flipped = buildOk(cubeMesh(true), p);
+    EXPECT_EQ(flipped.faces, FaceMode::CullBack);
+    EXPECT_NEAR(signedVolume(flipped.mesh), 8.0, 1e-5);
+
+    Mesh open = cubeMesh();
+    open.indices.resize(open.indices.size() - 6);  // one face missing: its hole shows the inside
+    EXPECT_EQ(buildOk(open, p).faces, FaceMode::TwoSided);
+
+    p.faces = FacePolicy::CullBack;
+    const LocalBsp forced = buildOk(open, p);
+    EXPECT_EQ(forced.faces, FaceMode::CullBack);
+    p.faces = FacePolicy::TwoSided;
+    const LocalBsp twoSided = buildOk(cubeMesh(true), p);
+    EXPECT_EQ(twoSided.faces, FaceMode::TwoSided);
+    EXPECT_NEAR(signedVolume(twoSided.mesh), -8.0, 1e-5) << "TwoSided leaves the winding as it was";
 }
 
 TEST(LocalBsp, BunnyDefaultsMatchThePaper) {

@@ -123,8 +123,11 @@ void applyTriangleOrder(Mesh& mesh, Subdivision& sub);
 /// One model per leaf, in node order: the leaf's triangles as a compact mesh (only the
 /// vertices it uses, normals copied, computed first when `mesh` has none) with a
 /// single-leaf local BSP, so each leaf is one object and one draw. Mesh space becomes the
-/// objects' world space (identity transforms). Names are "<mesh name>/leaf<i>".
-std::vector<LocalBsp> subdivisionLeafModels(const Mesh& mesh, const Subdivision& sub);
+/// objects' world space (identity transforms). Names are "<mesh name>/leaf<i>". Each leaf
+/// is drawn with `faces`, the whole mesh's face mode (a leaf alone is an open piece), and
+/// its triangles are in optimizeLeafOrder's order.
+std::vector<LocalBsp> subdivisionLeafModels(const Mesh& mesh, const Subdivision& sub,
+                                            FaceMode faces = FaceMode::TwoSided);
 
 /// Checks every invariant against `mesh`, by brute force (the tests' oracle and the file
 /// reader's check): each triangle exactly once; children contiguous, after their parent,
