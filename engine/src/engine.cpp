@@ -50,7 +50,7 @@ Expected<ModelId> Engine::addModel(const Mesh& mesh, const LocalBspParams& param
 Expected<ModelId> Engine::addModel(LocalBsp bsp) {
     if (Status s = context_.checkReset(); !s) return Error{s.message()};
     // Upload first: if the GPU refuses, nothing has been registered yet.
-    auto mesh = renderer_->upload(bsp.mesh);
+    auto mesh = renderer_->upload(bsp.mesh, bsp.faces);
     if (!mesh) return mesh.error();
     const ModelId id = objects_.addModel(std::move(bsp));
     if (meshOfModel_.size() <= id) meshOfModel_.resize(id + 1);

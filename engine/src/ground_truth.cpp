@@ -110,6 +110,7 @@ void GroundTruth::uploadModels(const SceneObjects& objects) {
         glEnableVertexArrayAttrib(g.vao, 0);
         glVertexArrayAttribFormat(g.vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
         glVertexArrayAttribBinding(g.vao, 0, 0);
+        g.cullBack = objects.model(id).faces == FaceMode::CullBack;
         models_.push_back(g);
     }
 }
@@ -147,7 +148,10 @@ VisibleSet GroundTruth::compute(const SceneObjects& objects, const Camera& camer
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glDepthMask(GL_TRUE);
     glDisable(GL_BLEND);
-    glDisable(GL_CULL_FACE);  // as the renderer: both sides of every triangle
+    // Faces as the renderer draws them: back faces culled per model (LocalBsp::faces).
+    glDisable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+    bool cullEnabled = false;
     detail::useReversedDepth();
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(detail::kDepthNearer);
@@ -161,13 +165,22 @@ VisibleSet GroundTruth::compute(const SceneObjects& objects, const Camera& camer
         const ModelId model = objects.modelOf(ref.object);
         const LocalBspNode& n = objects.model(model).nodes[ref.node];
         if (n.indexCount == 0) continue;
+        const glm::mat4& toWorld = objects.matrix(ref.object);
+        const bool cull = models_[model].cullBack;
+        if (cull != cullEnabled) {
+            cull ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
+            cullEnabled = cull;
+        }
+        if (cull) glFrontFace(glm::determinant(glm::mat3(toWorld)) > 0.0f ? GL_CCW : GL_CW);  // mirrored objects
         glUniform1ui(locId_, static_cast<GLuint>(i + 1));
-        glUniformMatrix4fv(locModel_, 1, GL_FALSE, glm::value_ptr(camera.relativeModel(objects.matrix(ref.object))));
+        glUniformMatrix4fv(locModel_, 1, GL_FALSE, glm::value_ptr(camera.relativeModel(toWorld)));
         glBindVertexArray(models_[model].vao);
         glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(n.indexCount), GL_UNSIGNED_INT,
                        reinterpret_cast<const void*>(static_cast<std::uintptr_t>(n.firstIndex) * sizeof(std::uint32_t)));
     }
     glBindVertexArray(0);
+    glDisable(GL_CULL_FACE);
+    glFrontFace(GL_CCW);
 
     const std::size_t rowPixels = static_cast<std::size_t>(width_);
     std::vector<std::uint32_t> bottomUp(rowPixels * static_cast<std::size_t>(height_));

@@ -1,4 +1,5 @@
-// Forward renderer: one VAO/VBO/IBO per mesh, drawn per index range with a model matrix.
+// Forward renderer: one VAO/VBO/IBO per mesh, drawn per index range with a model matrix,
+// back faces culled for meshes whose surface allows it.
 #include "dyncull/engine/renderer.hpp"
 
 #include <cassert>
@@ -16,15 +17,21 @@ namespace dyncull {
 
 Expected<std::unique_ptr<Renderer>> Renderer::create(GlContext& context) {
     std::unique_ptr<Renderer> r(new Renderer(context));
-    std::string log;
-    r->program_ = detail::buildProgram(detail::kLitVertexShader, detail::kLitFragmentShader, log);
-    if (!r->program_) return Error{"renderer: lit shader rejected by " + context.rendererName() + ": " + log};
-    r->locViewProj_ = glGetUniformLocation(r->program_, "uViewProj");
-    r->locModel_ = glGetUniformLocation(r->program_, "uModel");
-    r->locNormalMat_ = glGetUniformLocation(r->program_, "uNormalMat");
-    r->locColour_ = glGetUniformLocation(r->program_, "uColour");
-    r->locEye_ = glGetUniformLocation(r->program_, "uEye");
-    r->locLight_ = glGetUniformLocation(r->program_, "uLightDir");
+    const char* const sources[2][2] = {{detail::kVertexLitVertexShader, detail::kVertexLitFragmentShader},
+                                       {detail::kLitVertexShader, detail::kLitFragmentShader}};
+    static_assert(static_cast<int>(Shading::Vertex) == 0 && static_cast<int>(Shading::Pixel) == 1);
+    for (int i = 0; i < 2; ++i) {
+        std::string log;
+        LitProgram& p = r->programs_[i];
+        p.id = detail::buildProgram(sources[i][0], sources[i][1], log);
+        if (!p.id) return Error{"renderer: lit shader rejected by " + context.rendererName() + ": " + log};
+        p.viewProj = glGetUniformLocation(p.id, "uViewProj");
+        p.model = glGetUniformLocation(p.id, "uModel");
+        p.normalMat = glGetUniformLocation(p.id, "uNormalMat");
+        p.colour = glGetUniformLocation(p.id, "uColour");
+        p.eye = glGetUniformLocation(p.id, "uEye");  // -1 in the per-vertex program (the eye is the origin)
+        p.light = glGetUniformLocation(p.id, "uLightDir");
+    }
     r->boxes_ = std::make_unique<BoxDrawer>();
     if (!r->boxes_->valid()) return Error{std::string("renderer: box shader rejected: ") + r->boxes_->log()};
     return r;
@@ -37,10 +44,11 @@ Renderer::~Renderer() {
         glDeleteBuffers(1, &m.ibo);
     }
     boxes_.reset();
-    if (program_) glDeleteProgram(program_);
+    for (const LitProgram& p : programs_)
+        if (p.id) glDeleteProgram(p.id);
 }
 
-Expected<MeshId> Renderer::upload(const Mesh& mesh) {
+Expected<MeshId> Renderer::upload(const Mesh& mesh, FaceMode faces) {
     assert(validateMesh(mesh).empty());
     Mesh withNormals;
     const Mesh* src = &mesh;
@@ -56,6 +64,7 @@ Expected<MeshId> Renderer::upload(const Mesh& mesh) {
         interleaved[2 * i + 1] = src->normals[i];
     }
     GpuMesh g;
+    g.cullBack = faces == FaceMode::CullBack;
     g.indexCount = static_cast<std::uint32_t>(src->indices.size());
     const GLsizeiptr vbytes = static_cast<GLsizeiptr>(interleaved.size() * sizeof(glm::vec3));
     const GLsizeiptr ibytes = static_cast<GLsizeiptr>(src->indices.size() * sizeof(std::uint32_t));
@@ -105,7 +114,12 @@ void Renderer::beginFrame(const Camera& camera) {
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(detail::kDepthNearer);
-    glDisable(GL_CULL_FACE);  // loaded meshes have unreliable winding; the shader lights both sides
+    // Back faces are culled per mesh (GpuMesh::cullBack); drawRange switches the state.
+    glDisable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+    glFrontFace(GL_CCW);
+    cullEnabled_ = false;
+    frontCcw_ = true;
 
     viewProj_ = camera.viewProjection();
     // Camera-relative transforms: uViewProj has no translation and uModel carries the
@@ -121,11 +135,12 @@ void Renderer::beginFrame(const Camera& camera) {
     const glm::vec3 up = glm::cross(right, f);
     const glm::vec3 light = glm::normalize(-f + 0.9f * up - 0.6f * right);
 
-    glUseProgram(program_);
-    glUniformMatrix4fv(locViewProj_, 1, GL_FALSE, glm::value_ptr(viewProjRel));
+    const LitProgram& p = programs_[static_cast<int>(shading_)];
+    glUseProgram(p.id);
+    glUniformMatrix4fv(p.viewProj, 1, GL_FALSE, glm::value_ptr(viewProjRel));
     const glm::vec3 eyeRelative(0.0f);
-    glUniform3fv(locEye_, 1, glm::value_ptr(eyeRelative));
-    glUniform3fv(locLight_, 1, glm::value_ptr(light));
+    if (p.eye >= 0) glUniform3fv(p.eye, 1, glm::value_ptr(eyeRelative));
+    glUniform3fv(p.light, 1, glm::value_ptr(light));
 }
 
 void Renderer::drawRange(MeshId id, std::uint32_t firstIndex, std::uint32_t count, const glm::mat4& model,
@@ -136,12 +151,27 @@ void Renderer::drawRange(MeshId id, std::uint32_t firstIndex, std::uint32_t coun
     if (count == 0) return;
     // Inverse-transpose keeps normals perpendicular under non-uniform scale; done once per
     // draw on the CPU instead of per vertex.
-    const glm::mat3 normalMat = glm::inverseTranspose(glm::mat3(model));
-    glUseProgram(program_);
+    const glm::mat3 linear(model);
+    const glm::mat3 normalMat = glm::inverseTranspose(linear);
+    const bool cull = g.cullBack && cullBackFaces_;
+    if (cull != cullEnabled_) {
+        cull ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
+        cullEnabled_ = cull;
+    }
+    // A mirroring matrix (negative determinant) turns counter-clockwise triangles clockwise.
+    const bool ccw = glm::determinant(linear) > 0.0f;
+    if (cull && ccw != frontCcw_) {
+        glFrontFace(ccw ? GL_CCW : GL_CW);
+        frontCcw_ = ccw;
+    }
+    const LitProgram& p = programs_[static_cast<int>(shading_)];
+    glUseProgram(p.id);
     const glm::mat4 relative = camera_.relativeModel(model);
-    glUniformMatrix4fv(locModel_, 1, GL_FALSE, glm::value_ptr(relative));
-    glUniformMatrix3fv(locNormalMat_, 1, GL_FALSE, glm::value_ptr(normalMat));
-    glUniform3fv(locColour_, 1, glm::value_ptr(colour));
+    glUniformMatrix4fv(p.model, 1, GL_FALSE, glm::value_ptr(relative));
+    glUniformMatrix3fv(p.normalMat, 1, GL_FALSE, glm::value_ptr(normalMat));
+    // The per-vertex program takes the colour with the display gamma applied (see shaders.cpp).
+    const glm::vec3 c = shading_ == Shading::Vertex ? glm::pow(glm::max(colour, glm::vec3(0.0f)), glm::vec3(1.0f / 1.2f)) : colour;
+    glUniform3fv(p.colour, 1, glm::value_ptr(c));
     glBindVertexArray(g.vao);
     glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(count), GL_UNSIGNED_INT,
                    reinterpret_cast<const void*>(static_cast<std::uintptr_t>(firstIndex) * sizeof(std::uint32_t)));

@@ -1,11 +1,46 @@
 // GLSL sources. Lighting is deliberately simple and camera-relative so any model reads
 // clearly from any framing: a key light above-left of the eye, a hemispheric ambient and
-// a view-facing fill; normals are flipped towards the viewer because scanned/CAD meshes
-// often have inconsistent winding and we draw without back-face culling.
+// a view-facing fill. Normals are turned towards the viewer because meshes drawn
+// two-sided (open or inconsistently wound, see surface_orientation.hpp) show their backs.
+// The default evaluates it per vertex: on llvmpipe every fragment costs CPU time and a
+// dense scene shades each pixel several times, while its triangles are a few pixels big.
 #include "shader_program.hpp"
 
 namespace dyncull::detail {
 
+// Per-vertex lighting (Shading::Vertex). The light is white, so only its intensity varies
+// over a surface: one interpolated float instead of a colour (llvmpipe sets up every
+// varying of every triangle, and the swarm's triangles are smaller than a pixel). The
+// display gamma is separable, pow(c * i, g) = pow(c, g) * pow(i, g), so the colour's part
+// is a uniform (uColour is given already raised to 1 / 1.2 by the renderer).
+const char* const kVertexLitVertexShader = R"(#version 450 core
+layout(location = 0) in vec3 aPosition;
+layout(location = 1) in vec3 aNormal;
+uniform mat4 uViewProj;
+uniform mat4 uModel;
+uniform mat3 uNormalMat;
+uniform vec3 uLightDir;  // towards the light, unit, world space
+out float vIntensity;
+void main() {
+    vec4 world = uModel * vec4(aPosition, 1.0);  // relative to the eye (camera-relative)
+    gl_Position = uViewProj * world;
+    vec3 n = normalize(uNormalMat * aNormal);
+    float nv = dot(n, normalize(-world.xyz));
+    if (nv < 0.0) { n = -n; nv = -nv; }
+    float key = max(dot(n, uLightDir), 0.0);
+    float hemi = 0.5 + 0.5 * n.y;
+    vIntensity = pow(0.18 + 0.12 * hemi + 0.55 * key + 0.22 * nv * nv, 1.0 / 1.2);
+}
+)";
+
+const char* const kVertexLitFragmentShader = R"(#version 450 core
+in float vIntensity;
+uniform vec3 uColour;  // already raised to 1 / 1.2
+out vec4 fragColour;
+void main() { fragColour = vec4(min(uColour * vIntensity, vec3(1.0)), 1.0); }
+)";
+
+// Per-pixel lighting (Shading::Pixel): the same terms evaluated per fragment.
 const char* const kLitVertexShader = R"(#version 450 core
 layout(location = 0) in vec3 aPosition;
 layout(location = 1) in vec3 aNormal;

@@ -3,6 +3,8 @@
 // pixel for pixel. Also the drawn-part recorder and the part comparison.
 #include <gtest/gtest.h>
 
+#include <glm/gtc/quaternion.hpp>
+
 #include "dyncull/engine/engine.hpp"
 #include "dyncull/engine/ground_truth.hpp"
 #include "engine/gl_test_util.hpp"
@@ -85,6 +87,20 @@ TEST_F(QuadAndCube, PartlyHiddenCubeCountsItsOwnPixels) {
     EXPECT_GT(q, 0u);
     EXPECT_GT(c, 0u);
     EXPECT_EQ(std::uint64_t{q} + c, vs.coveredPixels);
+    expectCoverageMatchesRender(vs);
+}
+
+TEST_F(QuadAndCube, MirroredCulledCubeIsSeenAsTheRendererDrawsIt) {
+    // The cube is closed and outward, so both passes cull its back faces; a mirroring
+    // transform turns its triangles clockwise, which both must account for, or the ID pass
+    // would see the cube's inside (or nothing) where the renderer drew its outside.
+    ASSERT_EQ(engine->model(engine->objects().modelOf(cube.index)).faces, FaceMode::CullBack);
+    Transform mirrored = at({0.3f, 0.2f, 1.0f});
+    mirrored.scale = {-1.0f, 1.0f, 1.0f};
+    mirrored.rotation = glm::angleAxis(0.5f, glm::normalize(glm::vec3(1, 2, 3)));
+    ASSERT_TRUE(engine->setTransform(cube, mirrored).ok());
+    const VisibleSet vs = truth->compute(*engine, engine->camera());
+    EXPECT_GT(vs.pixelsOf({cube.index, 0}), 100u);
     expectCoverageMatchesRender(vs);
 }
 

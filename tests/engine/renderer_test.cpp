@@ -50,6 +50,35 @@ TEST_F(RendererTest, RedQuadFillsTheCentre) {
     EXPECT_EQ(renderer->stats().triangles, 2u);
 }
 
+TEST_F(RendererTest, CulledClosedCubeLooksTwoSidedFromOutsideEvenMirrored) {
+    const Mesh cube = test::cubeMesh(0.6f);
+    ASSERT_EQ(analyseSurface(cube).mode, FaceMode::CullBack);
+    const MeshId culled = *renderer->upload(cube, FaceMode::CullBack);
+    const MeshId both = *renderer->upload(cube, FaceMode::TwoSided);
+    const glm::mat4 turned = glm::rotate(glm::mat4(1.0f), 0.7f, glm::normalize(glm::vec3(1, 2, 3)));
+    for (const glm::mat4& model : {turned, glm::scale(turned, {-1.0f, 1.0f, 1.0f})}) {
+        Image img[2];
+        for (int i = 0; i < 2; ++i) {
+            renderer->beginFrame(test::cameraOnZ(3.0f));
+            renderer->drawMesh(i == 0 ? culled : both, model, {0.8f, 0.5f, 0.2f});
+            renderer->endFrame();
+            img[i] = renderer->readPixels();
+        }
+        EXPECT_FALSE(test::isClear(img[0].at(32, 32))) << "a mirrored cube lost its front faces";
+        EXPECT_EQ(img[0].rgba, img[1].rgba);
+    }
+    // From inside, a closed surface shows only back faces: culled, nothing is drawn.
+    Image inside[2];
+    for (int i = 0; i < 2; ++i) {
+        renderer->beginFrame(test::cameraOnZ(0.1f));
+        renderer->drawMesh(i == 0 ? culled : both, glm::mat4(1.0f), {0.8f, 0.5f, 0.2f});
+        renderer->endFrame();
+        inside[i] = renderer->readPixels();
+    }
+    EXPECT_TRUE(test::isClear(inside[0].at(32, 32)));
+    EXPECT_FALSE(test::isClear(inside[1].at(32, 32)));
+}
+
 TEST_F(RendererTest, ReadPixelsIsTopDown) {
     const MeshId quad = *renderer->upload(test::quadMesh(0.3f));
     renderer->beginFrame(test::cameraOnZ(3.0f));

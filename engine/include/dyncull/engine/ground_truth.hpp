@@ -81,6 +81,7 @@ private:
 
     struct GpuModel {
         std::uint32_t vao = 0, vbo = 0, ibo = 0;
+        bool cullBack = false;  // the model's FaceMode, as the renderer draws it
     };
     GlContext& context_;
     std::uint32_t fbo_ = 0, colour_ = 0, depth_ = 0, program_ = 0;

@@ -1,7 +1,8 @@
 // Forward renderer for dyncull scenes: each mesh uploaded once (instances share its
 // buffers), drawn per index range with a model matrix, so a local-BSP leaf is one
 // glDrawElements on a sub-range with the object's matrix. Simple lighting so shapes
-// read clearly in screenshots: Lambert key light + ambient + a view-dependent fill.
+// read clearly in screenshots: Lambert key light + ambient + a view-dependent fill,
+// evaluated per vertex by default (Shading).
 #pragma once
 
 #include <cstdint>
@@ -16,11 +17,20 @@
 #include "dyncull/objects/camera.hpp"
 #include "dyncull/objects/error.hpp"
 #include "dyncull/objects/mesh.hpp"
+#include "dyncull/objects/surface_orientation.hpp"
 
 namespace dyncull {
 
 /// Index of an uploaded mesh in the Renderer (0, 1, 2, ... in upload order).
 using MeshId = std::uint32_t;
+
+/// Where the lighting is evaluated. Both give the same terms; per vertex costs a few
+/// dozen operations per vertex and leaves the fragment stage a copy, per pixel costs them
+/// for every shaded fragment (several per pixel in a dense scene).
+enum class Shading : std::uint8_t {
+    Vertex,  ///< default
+    Pixel,
+};
 
 /// Counters of the current (or last) frame; reset by beginFrame.
 struct RenderStats {
@@ -39,12 +49,14 @@ public:
     Renderer(const Renderer&) = delete;
     Renderer& operator=(const Renderer&) = delete;
 
-    /// Uploads positions + normals (interleaved) and indices once. Normals are computed
+    /// Uploads positions + normals (interleaved) and indices once, to be drawn with back
+    /// faces culled or both sides (the mesh's FaceMode, see surface_orientation.hpp: only a
+    /// closed, outward surface may be culled without showing holes). Normals are computed
     /// if the mesh has none. The mesh must pass validateMesh (loaders guarantee it) and
     /// have fewer than 2^32 indices. If the driver cannot allocate the buffers
     /// (GL_OUT_OF_MEMORY) returns "out of GPU memory uploading mesh 'name' (N bytes)" and
     /// keeps nothing: buffers made for it are deleted, meshCount() is unchanged.
-    Expected<MeshId> upload(const Mesh& mesh);
+    Expected<MeshId> upload(const Mesh& mesh, FaceMode faces = FaceMode::TwoSided);
     std::uint32_t indexCount(MeshId id) const { return meshes_[id].indexCount; }
     std::size_t meshCount() const { return meshes_.size(); }
     /// GPU memory held by mesh buffers, bytes.
@@ -56,7 +68,8 @@ public:
     /// aspect is used as given (set it to width/height of the context).
     void beginFrame(const Camera& camera);
     /// Draws indices [firstIndex, firstIndex + indexCount) of mesh `id` with object-to-world
-    /// matrix `model`, in linear-ish RGB `colour` (0..1).
+    /// matrix `model`, in linear-ish RGB `colour` (0..1). Culls back faces if the mesh was
+    /// uploaded with FaceMode::CullBack (a mirroring `model` is accounted for).
     void drawRange(MeshId id, std::uint32_t firstIndex, std::uint32_t indexCount, const glm::mat4& model,
                    const glm::vec3& colour);
     void drawMesh(MeshId id, const glm::mat4& model, const glm::vec3& colour) {
@@ -73,6 +86,12 @@ public:
     /// Reads the context framebuffer as a top-down RGBA8 image (waits for the GPU).
     Image readPixels() const;
 
+    /// Lighting path of the next frames (default Shading::Vertex).
+    void setShading(Shading shading) { shading_ = shading; }
+    Shading shading() const { return shading_; }
+    /// false draws every mesh two-sided whatever its FaceMode (to measure what culling saves).
+    void setBackFaceCulling(bool honour) { cullBackFaces_ = honour; }
+
     const RenderStats& stats() const { return stats_; }
     const glm::mat4& viewProjection() const { return viewProj_; }
     GlContext& context() { return context_; }
@@ -86,12 +105,19 @@ private:
     struct GpuMesh {
         std::uint32_t vao = 0, vbo = 0, ibo = 0;
         std::uint32_t indexCount = 0;
+        bool cullBack = false;
+    };
+    struct LitProgram {
+        std::uint32_t id = 0;
+        int viewProj = -1, model = -1, normalMat = -1, colour = -1, eye = -1, light = -1;
     };
     GlContext& context_;
     std::vector<GpuMesh> meshes_;
     std::size_t uploadedBytes_ = 0;
-    std::uint32_t program_ = 0;
-    int locViewProj_ = -1, locModel_ = -1, locNormalMat_ = -1, locColour_ = -1, locEye_ = -1, locLight_ = -1;
+    LitProgram programs_[2];  // indexed by Shading
+    Shading shading_ = Shading::Vertex;
+    bool cullBackFaces_ = true;
+    bool cullEnabled_ = false, frontCcw_ = true;  // GL state as drawRange last set it in this frame
     glm::mat4 viewProj_{1.0f};  // world space (box overlays); parts are drawn camera-relative
     Camera camera_;             // of the current frame, for camera-relative model matrices
     RenderStats stats_;
