@@ -2,6 +2,7 @@
 // the default) or in a window, writing per-frame stats (CSV) and screenshots.
 #include <algorithm>
 #include <cstdio>
+#include <map>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -34,6 +35,7 @@ struct RunOptions {
     std::vector<std::uint64_t> shots;
     bool window = false;
     bool boxes = false;
+    Shading shading = Shading::Vertex;
     SceneOptions sceneOptions;
     SchedulerFlags flags;
 };
@@ -90,6 +92,7 @@ void runRun(RunOptions o) {
     auto engineOr = Engine::create(ctx, eo);
     if (!engineOr) fail(engineOr.error().message);
     Engine& engine = **engineOr;
+    engine.renderer().setShading(o.shading);
     if (Status s = scene.populate(engine); !s) fail(s.message());
     std::printf("%s\n", scene.description().c_str());
     std::printf("context: %s, %s; set-up %.0f ms\n", ctx.platformName().c_str(), ctx.rendererName().c_str(), scene.setupMs());
@@ -201,6 +204,9 @@ void registerRun(CLI::App& app) {
         ->check(wholeIn(0, kMaxFrames))
         ->delimiter(',');
     cmd->add_flag("--window", o->window, "interactive GLFW window (fly, 1/2/3 modes, B node boxes; --frames limits it)");
+    cmd->add_option("--shading", o->shading, "lighting per vertex (fast) or per pixel")
+        ->transform(CLI::CheckedTransformer(std::map<std::string, Shading>{{"vertex", Shading::Vertex}, {"pixel", Shading::Pixel}}))
+        ->default_str("vertex");
     cmd->add_flag("--boxes", o->boxes, "draw the node-box view (scheduler decisions) and stats over each frame");
     addBunnyOptions(*cmd, o->sceneOptions.bunny);
     addGeneratedSceneOptions(*cmd, o->sceneOptions);

@@ -1,5 +1,7 @@
 #include "scene_options.hpp"
 
+#include <map>
+
 namespace dyncull::cli {
 
 void addBunnyOptions(CLI::App& cmd, BunnySwarmOptions& o) {
@@ -26,6 +28,15 @@ void addBunnyOptions(CLI::App& cmd, BunnySwarmOptions& o) {
     cmd.add_option("--path-frames", o.frames, "bunnies: frames of one pass of the camera path")
         ->check(wholeIn(1, kMaxFrames))
         ->capture_default_str();
+    cmd.add_option("--faces", o.faces,
+                   "bunnies: auto (cull back faces only if the surface is closed and outward), cull (always: holes "
+                   "show through) or two-sided")
+        ->transform(CLI::CheckedTransformer(std::map<std::string, FacePolicy>{{"auto", FacePolicy::Auto},
+                                                                              {"cull", FacePolicy::CullBack},
+                                                                              {"two-sided", FacePolicy::TwoSided}}))
+        ->default_str("auto");
+    cmd.add_flag("--keep-holes", o.keepHoles,
+                 "bunnies: keep the mesh's holes open (by default the scanned bunny's base is capped, so it is closed)");
 }
 
 void addMeasureOptions(CLI::App& cmd, MeasureOptions& o, std::string& size, const std::string& defaultOut) {

@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "dyncull/demos/demo_scene.hpp"
+#include "dyncull/objects/hole_capping.hpp"
 #include "dyncull/objects/loaders.hpp"
 #include "dyncull/objects/loop_subdivision.hpp"
 #include "dyncull/objects/motion.hpp"
@@ -57,8 +58,12 @@ public:
         if (choice->subdivided) mesh = loopSubdivide(mesh, 2);
         normalise(mesh, o_.bunnySize);
         const std::size_t triangles = mesh.triangleCount();
+        HoleCapping capped;
+        if (!o_.keepHoles) capped = capHoles(mesh, mesh.indices.size());
         LocalBspParams bspParams;
         bspParams.maxLeafTriangles = o_.leafTriangles;
+        bspParams.faces = o_.faces;
+        bspParams.optimizeOrder = o_.optimizeOrder;
         auto model = engine.addModel(mesh, bspParams);
         if (!model) return Error{model.error().message};
         const LocalBsp& bsp = engine.model(*model);
@@ -69,6 +74,10 @@ public:
         }
         description_ = "bunny mesh: " + choice->path + " (" + std::to_string(original) + " triangles" +
                        (choice->subdivided ? ", 2 levels of Loop subdivision -> " + std::to_string(triangles) : std::string()) +
+                       (capped.holes ? ", " + std::to_string(capped.holes) + " holes capped with " +
+                                           std::to_string(capped.triangles) + " triangles"
+                                     : std::string()) +
+                       "; drawn " + (bsp.faces == FaceMode::CullBack ? "with back faces culled" : "two-sided") +
                        "); local BSP: " + std::to_string(bsp.stats.leaves) + " parts, " +
                        std::to_string(bsp.stats.trianglesAfter) + " triangles; " + std::to_string(o_.count) +
                        " bunnies in a box of side " + fmt(o_.box) + ", bunny size " + fmt(o_.bunnySize);

@@ -143,12 +143,14 @@ Status GeneratedDemoScene::populate(Engine& engine) {
     objectCount_ = prepared->objects.size();
     modelCount_ = prepared->models.size();
     triangles_ = prepared->instancedTriangles();
-    std::size_t generated = 0;
+    std::size_t generated = 0, culledModels = 0;
     for (const PlacedObject& o : prepared->objects) generated += prepared->models[o.model].stats.trianglesBefore;
+    for (const LocalBsp& m : prepared->models) culledModels += m.faces == FaceMode::CullBack;
     if (Status s = populateEngine(engine, prepared.take()); !s) return s;
     description_ = name() + ": " + std::to_string(objectCount_) + " objects, " + std::to_string(modelCount_) +
                    " meshes, " + std::to_string(generated) + " triangles (" + std::to_string(triangles_) +
-                   " after local-BSP splitting); " + log;
+                   " after local-BSP splitting); " + std::to_string(culledModels) + " of " +
+                   std::to_string(modelCount_) + " meshes closed and drawn with back faces culled, the rest two-sided; " + log;
     setupMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     return {};
 }

@@ -157,6 +157,7 @@ Status writeSceneCache(const std::filesystem::path& path, const PreparedScene& s
         w.put(b.stats.depth);
         w.put(b.stats.stalledLeaves);
         w.put(b.stats.buildMs);
+        w.put(static_cast<std::uint8_t>(b.faces));
     }
     w.put(static_cast<std::uint32_t>(scene.objects.size()));
     for (const PlacedObject& o : scene.objects) {
@@ -254,7 +255,10 @@ Expected<PreparedScene> readSceneCache(const std::filesystem::path& path, std::u
         b.stats.depth = r.get<std::uint32_t>();
         b.stats.stalledLeaves = r.get<std::uint32_t>();
         b.stats.buildMs = r.get<double>();
+        const auto faces = r.get<std::uint8_t>();
         if (r.failed()) return bad(path, at + "truncated tree");
+        if (faces > static_cast<std::uint8_t>(FaceMode::TwoSided)) return bad(path, at + "unknown face mode " + std::to_string(faces));
+        b.faces = static_cast<FaceMode>(faces);
         if (!std::isfinite(b.stats.buildMs) || b.stats.buildMs < 0.0) return bad(path, at + "build time is not a finite duration");
         if (std::string why = validateTree(b); !why.empty()) return bad(path, at + why);
     }

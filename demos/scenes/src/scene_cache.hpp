@@ -6,7 +6,7 @@
 //   magic "DYNCSCN\0" | u32 format version | u32 header size (40) | u64 generator
 //   parameters hash | u64 payload size | u64 FNV-1a 64 of the payload
 // then the payload: u32 model count, per model (name, positions, normals, indices, nodes,
-// stats), u32 object count, per object (model, translation, rotation wxyz, scale, static).
+// stats, u8 face mode), u32 object count, per object (model, translation, rotation wxyz, scale, static).
 #pragma once
 
 #include <cstddef>
@@ -19,7 +19,7 @@
 
 namespace dyncull {
 
-inline constexpr std::uint32_t kSceneCacheVersion = 1;
+inline constexpr std::uint32_t kSceneCacheVersion = 2;  // 2: face mode per model, leaves in cache order
 inline constexpr std::size_t kSceneCacheHeaderSize = 40;
 
 /// Writes `scene` to `path` (via a temporary file renamed into place, so readers never see

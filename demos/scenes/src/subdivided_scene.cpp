@@ -10,6 +10,7 @@
 
 #include "dyncull/demos/demo_scene.hpp"
 #include "dyncull/objects/loaders.hpp"
+#include "dyncull/objects/surface_orientation.hpp"
 #include "generators.hpp"
 
 namespace dyncull {
@@ -67,7 +68,11 @@ public:
                              "' with other generator options; pass the --plant-*/--city-* options it was made with"};
             bounds_ = model->mesh.bounds();
             if (!builtinCameraScene(source_, options_)) walkthrough_ = staticModelWalkthrough(model->mesh);
-            leaves = subdivisionLeafModels(model->mesh, model->subdivision);
+            // The whole model's surface decides (one leaf alone is an open piece); shells
+            // wound inwards were flipped before subdividing (subdivideStaticScene).
+            const SurfaceReport surface = analyseSurface(model->mesh);
+            leaves = subdivisionLeafModels(model->mesh, model->subdivision, surface.mode);
+            surface_ = surface.summary();
             triangles = model->mesh.triangleCount();
             stats = model->subdivision.stats;
             params = model->params;
@@ -89,7 +94,7 @@ public:
                       file_.empty() ? "" : (" (read from " + file_ + ")").c_str(), triangles, stats.nodes, stats.inner,
                       stats.leaves, stats.depth, stats.largestLeaf, stats.buildMs, toString(params.method), stats.nodes,
                       stats.inner, stats.leaves, stats.depth, stats.buildMs, triangles);
-        description_ = line;
+        description_ = std::string(line) + "\nsurface: " + surface_;
         setupMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         return {};
     }
@@ -107,7 +112,7 @@ public:
     }
 
 private:
-    std::string source_, file_, name_, description_;
+    std::string source_, file_, name_, description_, surface_;
     SceneOptions options_;
     std::unique_ptr<DemoScene> camera_;
     Aabb bounds_;
@@ -159,6 +164,7 @@ Expected<SubdividedModel> subdivideStaticScene(const std::string& nameOrPath, co
     if (!soup) return soup.error();
     SubdividedModel m;
     m.mesh = std::move(soup->mesh);
+    orientSurface(m.mesh);  // before subdividing: the model file keeps the oriented triangles
     m.source = soup->source;
     m.sourceHash = soup->sourceHash;
     m.params = *params;

@@ -53,6 +53,13 @@ struct BunnySwarmOptions {
     /// Local-BSP leaf size (triangles). Smaller leaves cull finer but cost more queries;
     /// 5000 gives the two-level paper's 23-24 parts per bunny.
     std::uint32_t leafTriangles = LocalBspParams{}.maxLeafTriangles;
+    /// Which faces are drawn (LocalBspParams::faces; Auto draws an open mesh two-sided).
+    FacePolicy faces = LocalBspParams{}.faces;
+    /// false: the mesh's holes are capped at load (capHoles), which closes a scanned solid
+    /// such as the Stanford bunny (five holes in its base) so that Auto culls back faces.
+    bool keepHoles = false;
+    /// Triangles reordered inside each part for the vertex cache and overdraw (LocalBspParams::optimizeOrder).
+    bool optimizeOrder = LocalBspParams{}.optimizeOrder;
 };
 
 /// Where the bunny mesh comes from, in order: `meshPath`; `<assets>/bun_zipper.ply` (the
