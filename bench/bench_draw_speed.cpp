@@ -1,0 +1,365 @@
+// Draw speed against a speed-of-light reference, interleaved per frame on the bunny swarm.
+//
+// `sol` draws the same triangles (each bunny's split mesh) as fast as this context allows:
+// a position-only shader writing a constant colour, back faces culled, one draw per
+// bunny, no traversal. Every other variant is dyncull's own frame (Engine::renderFrame in
+// vfc mode) with one setting changed, so the table splits the renderer's cost into its
+// parts: shading per vertex or per pixel, culled back faces, triangle order in the parts.
+// `*-discard` variants run the same frame with GL_RASTERIZER_DISCARD: vertex work and
+// per-draw overhead only, so total minus discard is the rasterisation and fragment cost.
+//
+// Usage: bench_draw_speed [--frames N] [--count 300] [--box 8] [--bunny-size 1]
+//        [--orbit 12] [--speed 0.02] [--size 640x360] [--out DIR] [--mesh FILE]
+// Prints a table (median ms, triangles, ns per triangle, ratio to sol) and writes
+// DIR/draw_speed.csv plus the first frame of each variant as DIR/<variant>.png.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <epoxy/gl.h>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "dyncull/demos/demo_scene.hpp"
+#include "dyncull/engine/engine.hpp"
+#include "dyncull/engine/gl_context.hpp"
+#include "dyncull/engine/image.hpp"
+#include "dyncull/engine/image_compare.hpp"
+#include "dyncull/objects/checked_write.hpp"
+
+namespace dyncull {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+const char* const kSolVertex = R"(#version 450 core
+layout(location = 0) in vec3 aPosition;
+uniform mat4 uViewProj;
+uniform mat4 uModel;
+void main() { gl_Position = uViewProj * (uModel * vec4(aPosition, 1.0)); }
+)";
+const char* const kSolFragment = R"(#version 450 core
+out vec4 fragColour;
+void main() { fragColour = vec4(0.8, 0.7, 0.6, 1.0); }
+)";
+
+GLuint compile(GLenum stage, const char* source) {
+    const GLuint s = glCreateShader(stage);
+    glShaderSource(s, 1, &source, nullptr);
+    glCompileShader(s);
+    GLint ok = 0;
+    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+        char log[1024] = {};
+        glGetShaderInfoLog(s, sizeof log, nullptr, log);
+        std::fprintf(stderr, "bench_draw_speed: shader: %s\n", log);
+        std::exit(1);
+    }
+    return s;
+}
+
+// The reference: the model's split mesh (positions only) drawn whole per object.
+class SpeedOfLight {
+public:
+    explicit SpeedOfLight(const Engine& engine) {
+        program_ = glCreateProgram();
+        const GLuint vs = compile(GL_VERTEX_SHADER, kSolVertex), fs = compile(GL_FRAGMENT_SHADER, kSolFragment);
+        glAttachShader(program_, vs);
+        glAttachShader(program_, fs);
+        glLinkProgram(program_);
+        glDeleteShader(vs);
+        glDeleteShader(fs);
+        locViewProj_ = glGetUniformLocation(program_, "uViewProj");
+        locModel_ = glGetUniformLocation(program_, "uModel");
+        const SceneObjects& objs = engine.objects();
+        for (ModelId m = 0; m < objs.modelCount(); ++m) {
+            const Mesh& mesh = objs.model(m).mesh;
+            Gpu g;
+            g.count = static_cast<GLsizei>(mesh.indices.size());
+            g.box = objs.model(m).root().box;
+            glCreateBuffers(1, &g.vbo);
+            glNamedBufferStorage(g.vbo, static_cast<GLsizeiptr>(mesh.positions.size() * sizeof(glm::vec3)),
+                                 mesh.positions.data(), 0);
+            glCreateBuffers(1, &g.ibo);
+            glNamedBufferStorage(g.ibo, static_cast<GLsizeiptr>(mesh.indices.size() * 4), mesh.indices.data(), 0);
+            glCreateVertexArrays(1, &g.vao);
+            glVertexArrayVertexBuffer(g.vao, 0, g.vbo, 0, sizeof(glm::vec3));
+            glVertexArrayElementBuffer(g.vao, g.ibo);
+            glEnableVertexArrayAttrib(g.vao, 0);
+            glVertexArrayAttribFormat(g.vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
+            glVertexArrayAttribBinding(g.vao, 0, 0);
+            models_.push_back(g);
+        }
+    }
+    ~SpeedOfLight() {
+        for (Gpu& g : models_) {
+            glDeleteVertexArrays(1, &g.vao);
+            glDeleteBuffers(1, &g.vbo);
+            glDeleteBuffers(1, &g.ibo);
+        }
+        glDeleteProgram(program_);
+    }
+
+    /// Draws every object whose box meets the frustum, nearest first when `sorted` (as
+    /// vfc's front-to-back traversal: hidden fragments then fail the early depth test);
+    /// returns triangles drawn.
+    std::uint64_t draw(Engine& engine, bool cullBackFaces, bool sorted = true) {
+        Renderer& r = engine.renderer();
+        r.beginFrame(engine.camera());  // binds, clears and sets the depth convention like a frame
+        glUseProgram(program_);
+        glUniformMatrix4fv(locViewProj_, 1, GL_FALSE, glm::value_ptr(engine.camera().viewProjectionRelative()));
+        if (cullBackFaces) glEnable(GL_CULL_FACE);
+        const Frustum frustum = Frustum::fromCamera(engine.camera());
+        const SceneObjects& objs = engine.objects();
+        order_.clear();
+        for (std::uint32_t o = 0; o < objs.slotCount(); ++o) {
+            if (!objs.alive(o)) continue;
+            const Aabb box = transformAabb(objs.matrix(o), models_[objs.modelOf(o)].box);
+            if (frustum.outside(box)) continue;
+            order_.push_back({sorted ? glm::length(box.center() - engine.camera().position) : 0.0f, o});
+        }
+        std::stable_sort(order_.begin(), order_.end());
+        std::uint64_t triangles = 0;
+        for (const auto& [distance, o] : order_) {
+            const Gpu& g = models_[objs.modelOf(o)];
+            const glm::mat4& m = objs.matrix(o);
+            glUniformMatrix4fv(locModel_, 1, GL_FALSE, glm::value_ptr(engine.camera().relativeModel(m)));
+            glBindVertexArray(g.vao);
+            glDrawElements(GL_TRIANGLES, g.count, GL_UNSIGNED_INT, nullptr);
+            triangles += static_cast<std::uint64_t>(g.count) / 3;
+        }
+        glDisable(GL_CULL_FACE);
+        r.endFrame();
+        return triangles;
+    }
+
+private:
+    struct Gpu {
+        GLuint vao = 0, vbo = 0, ibo = 0;
+        GLsizei count = 0;
+        Aabb box;
+    };
+    GLuint program_ = 0;
+    GLint locViewProj_ = -1, locModel_ = -1;
+    std::vector<Gpu> models_;
+    std::vector<std::pair<float, std::uint32_t>> order_;  // (distance, object slot)
+};
+
+struct Variant {
+    std::string name;
+    std::string what;
+    std::function<std::uint64_t()> frame;  // draws one frame (finished), returns triangles
+    std::vector<double> ms;
+    std::uint64_t triangles = 0;
+    Image first;
+};
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+[[noreturn]] void fail(const std::string& message) {
+    std::fprintf(stderr, "bench_draw_speed: %s\n", message.c_str());
+    std::exit(1);
+}
+
+struct Swarm {
+    std::unique_ptr<DemoScene> scene;
+    std::unique_ptr<Engine> engine;
+    QueryScheduler vfc{[] {
+        SchedulerParams p;
+        p.mode = CullMode::Vfc;
+        return p;
+    }()};
+};
+
+Swarm makeSwarm(GlContext& ctx, BunnySwarmOptions options) {
+    Swarm s;
+    s.scene = makeBunnySwarm(options);
+    auto engine = Engine::create(ctx);
+    if (!engine) fail(engine.error().message);
+    s.engine = engine.take();
+    if (Status st = s.scene->populate(*s.engine); !st) fail(st.message());
+    return s;
+}
+
+}  // namespace
+}  // namespace dyncull
+
+int main(int argc, char** argv) {
+    using namespace dyncull;
+    CLI::App app{"Draw speed of dyncull's renderer against a speed-of-light reference (bunny swarm)"};
+    BunnySwarmOptions o;
+    o.count = 300;
+    o.box = 8.0f;
+    o.bunnySize = 1.0f;
+    o.speed = 0.02f;
+    o.orbit = 12.0f;
+    std::uint32_t frames = 9, first = 0;
+    std::string size = "640x360", out = "out/bench_draw_speed";
+    app.add_option("--frames", frames, "frames measured (every variant draws each)")->check(CLI::Range(1u, 100000u))->capture_default_str();
+    app.add_option("--first", first, "first frame of the swarm's path")->capture_default_str();
+    app.add_option("--count", o.count, "bunnies")->check(CLI::Range(1u, 100000u))->capture_default_str();
+    app.add_option("--box", o.box, "side of the box they move in")->check(CLI::Range(0.01f, 1e6f))->capture_default_str();
+    app.add_option("--bunny-size", o.bunnySize, "longest side of one bunny")->check(CLI::Range(0.001f, 1e5f))->capture_default_str();
+    app.add_option("--speed", o.speed, "world units per frame")->check(CLI::Range(0.0f, 1e4f))->capture_default_str();
+    app.add_option("--orbit", o.orbit, "orbit distance of the camera")->check(CLI::Range(0.01f, 1e7f))->capture_default_str();
+    app.add_option("--leaf-tris", o.leafTriangles, "local-BSP leaf size")->check(CLI::Range(1u, 100000000u))->capture_default_str();
+    app.add_option("--mesh", o.meshPath, "mesh file instead of the asset directory's bunny");
+    app.add_option("--size", size, "framebuffer WxH")->capture_default_str();
+    app.add_option("--out", out, "output directory")->capture_default_str();
+    std::string only;
+    app.add_option("--only", only, "comma-separated variants to run (default all), e.g. to profile one");
+    CLI11_PARSE(app, argc, argv);
+    int width = 0, height = 0;
+    if (std::sscanf(size.c_str(), "%dx%d", &width, &height) != 2 || width < 1 || height < 1 || width > 16384 || height > 16384)
+        fail("--size: expected WxH, e.g. 640x360");
+
+    ContextOptions co;
+    co.width = width;
+    co.height = height;
+    auto ctx = GlContext::create(co);
+    if (!ctx) fail(ctx.error().message);
+
+    // One engine per way of building the model; variants that differ only in renderer
+    // settings share one.
+    Swarm tuned = makeSwarm(**ctx, o);
+    BunnySwarmOptions loadOrder = o;
+    loadOrder.optimizeOrder = false;
+    Swarm unordered = makeSwarm(**ctx, loadOrder);
+    const bool culls = tuned.engine->model(0).faces == FaceMode::CullBack;
+    std::unique_ptr<Swarm> forced;  // FacePolicy::CullBack when Auto keeps the mesh two-sided
+    if (!culls) {
+        BunnySwarmOptions f = o;
+        f.faces = FacePolicy::CullBack;
+        forced = std::make_unique<Swarm>(makeSwarm(**ctx, f));
+    }
+    std::printf("%s\ncontext: %s, %s; %dx%d; the model is drawn %s\n", tuned.scene->description().c_str(),
+                (*ctx)->platformName().c_str(), (*ctx)->rendererName().c_str(), width, height,
+                culls ? "with back faces culled (closed and outward)" : "two-sided (FacePolicy::Auto: not closed)");
+    SpeedOfLight sol(*tuned.engine);
+
+    std::vector<Variant> variants;
+    auto finished = [](auto&& draw) {
+        return [draw]() -> std::uint64_t {
+            glFinish();
+            const std::uint64_t t = draw();
+            glFinish();
+            return t;
+        };
+    };
+    auto vfcFrame = [](Swarm& s, Shading shading, bool cull, bool discard) {
+        return [&s, shading, cull, discard]() -> std::uint64_t {
+            s.engine->renderer().setShading(shading);
+            s.engine->renderer().setBackFaceCulling(cull);
+            if (discard) glEnable(GL_RASTERIZER_DISCARD);
+            auto st = s.engine->renderFrame(s.vfc);
+            glDisable(GL_RASTERIZER_DISCARD);
+            s.engine->renderer().setShading(Shading::Vertex);
+            s.engine->renderer().setBackFaceCulling(true);
+            if (!st) fail(st.error().message);
+            return st->trianglesDrawn;
+        };
+    };
+    variants.push_back({"sol", "trivial shader, back faces culled, one draw per bunny",
+                        finished([&] { return sol.draw(*tuned.engine, true); }), {}, 0, {}});
+    variants.push_back({"sol-unsorted", "sol in object order instead of front to back",
+                        finished([&] { return sol.draw(*tuned.engine, true, false); }), {}, 0, {}});
+    variants.push_back({"sol-discard", "sol with rasteriser discard: vertex work only",
+                        finished([&] {
+                            glEnable(GL_RASTERIZER_DISCARD);
+                            const auto t = sol.draw(*tuned.engine, true);
+                            glDisable(GL_RASTERIZER_DISCARD);
+                            return t;
+                        }),
+                        {}, 0, {}});
+    variants.push_back({"vfc", "dyncull vfc: per-vertex lighting, faces as decided, parts in cache order",
+                        vfcFrame(tuned, Shading::Vertex, true, false), {}, 0, {}});
+    variants.push_back({"vfc-discard", "vfc with rasteriser discard: traversal, draws, vertex work",
+                        vfcFrame(tuned, Shading::Vertex, true, true), {}, 0, {}});
+    variants.push_back({"vfc-pixel", "vfc with per-pixel lighting", vfcFrame(tuned, Shading::Pixel, true, false), {}, 0, {}});
+    variants.push_back({"vfc-pixel-discard", "vfc-pixel with rasteriser discard",
+                        vfcFrame(tuned, Shading::Pixel, true, true), {}, 0, {}});
+    if (culls)
+        variants.push_back({"vfc-two-sided", "vfc drawing both sides", vfcFrame(tuned, Shading::Vertex, false, false), {}, 0, {}});
+    else
+        variants.push_back({"vfc-cull", "vfc with back faces culled anyway (FacePolicy::CullBack: holes show through)",
+                            vfcFrame(*forced, Shading::Vertex, true, false), {}, 0, {}});
+    variants.push_back({"vfc-load-order", "vfc with the parts' triangles in load order",
+                        vfcFrame(unordered, Shading::Vertex, true, false), {}, 0, {}});
+    variants.push_back({"vfc-before", "the renderer before issue 21: per-pixel, two-sided, load order",
+                        vfcFrame(unordered, Shading::Pixel, false, false), {}, 0, {}});
+
+    if (!only.empty()) {
+        const std::string list = "," + only + ",";
+        std::erase_if(variants, [&](const Variant& v) { return list.find("," + v.name + ",") == std::string::npos; });
+        if (variants.empty()) fail("--only: no such variant in '" + only + "'");
+    }
+    std::vector<Swarm*> swarms{&tuned, &unordered};
+    if (forced) swarms.push_back(forced.get());
+    const float aspect = static_cast<float>(width) / static_cast<float>(height);
+    // Frame -1 is a warm-up: llvmpipe compiles shader and state variants on first use,
+    // which would add hundreds of milliseconds to whichever variant meets them first.
+    for (std::int64_t f = -1; f < static_cast<std::int64_t>(frames); ++f) {
+        const std::uint64_t frame = first + static_cast<std::uint64_t>(std::max<std::int64_t>(f, 0));
+        for (Swarm* s : swarms) {
+            if (Status st = s->scene->update(*s->engine, frame); !st) fail(st.message());
+            if (Status st = s->engine->setCamera(s->scene->camera(frame, aspect)); !st) fail(st.message());
+            s->engine->updateSceneTree();
+        }
+        // Rotate the order every frame so no variant always runs right after the same one.
+        for (std::size_t k = 0; k < variants.size(); ++k) {
+            Variant& v = variants[(k + static_cast<std::size_t>(f + 1)) % variants.size()];
+            const auto t0 = Clock::now();
+            v.triangles = v.frame();
+            const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+            if (f < 0) continue;
+            v.ms.push_back(ms);
+            if (f == 0 && v.name.find("discard") == std::string::npos) v.first = tuned.engine->renderer().readPixels();
+        }
+        if (f >= 0) std::fprintf(stderr, "\rframe %lld/%u", static_cast<long long>(f + 1), frames);
+    }
+    std::fprintf(stderr, "\n");
+
+    std::error_code ec;
+    std::filesystem::create_directories(out, ec);
+    std::ofstream csv;
+    const std::filesystem::path csvPath = std::filesystem::path(out) / "draw_speed.csv";
+    if (Status s = openChecked(csv, csvPath); !s) fail(s.message());
+    csv << "variant,median_ms,mean_ms,frames,triangles,ns_per_triangle,vs_sol\n";
+    const double solMs = median(variants[0].ms);
+    std::printf("%-18s %9s %9s %11s %8s %7s  %s\n", "variant", "median_ms", "mean_ms", "triangles", "ns/tri", "vs_sol",
+                "what");
+    for (const Variant& v : variants) {
+        const double med = median(v.ms);
+        double mean = 0;
+        for (double x : v.ms) mean += x / static_cast<double>(v.ms.size());
+        const double nsPerTri = v.triangles ? 1e6 * med / static_cast<double>(v.triangles) : 0.0;
+        std::printf("%-18s %9.1f %9.1f %11llu %8.1f %7.2f  %s\n", v.name.c_str(), med, mean,
+                    static_cast<unsigned long long>(v.triangles), nsPerTri, med / solMs, v.what.c_str());
+        csv << v.name << ',' << med << ',' << mean << ',' << v.ms.size() << ',' << v.triangles << ',' << nsPerTri << ','
+            << med / solMs << '\n';
+        if (!v.first.rgba.empty())
+            if (Status s = writePng(v.first, std::filesystem::path(out) / (v.name + ".png")); !s) fail(s.message());
+    }
+    if (Status s = closeChecked(csv, csvPath); !s) fail(s.message());
+    // Culling back faces of a closed surface and reordering triangles inside a part must
+    // not change the picture (depth ties aside); per-pixel lighting changes it slightly.
+    const auto vfc = std::find_if(variants.begin(), variants.end(), [](const Variant& v) { return v.name == "vfc"; });
+    const Image& ref = vfc != variants.end() ? vfc->first : variants[0].first;
+    for (const Variant& v : variants)
+        if (!v.first.rgba.empty() && &v.first != &ref && v.name.rfind("sol", 0) != 0)
+            if (auto d = compareImages(ref, v.first))
+                std::printf("pixels differing from vfc, frame %u: %-16s %llu (%.3f%%)\n", first, v.name.c_str(),
+                            static_cast<unsigned long long>(d->differingPixels), d->percentDiffering);
+    std::printf("wrote %s and the first frame of each variant as PNG in %s\n", csvPath.c_str(), out.c_str());
+    return 0;
+}
