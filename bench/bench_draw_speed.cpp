@@ -32,6 +32,7 @@
 #include "dyncull/engine/image.hpp"
 #include "dyncull/engine/image_compare.hpp"
 #include "dyncull/objects/checked_write.hpp"
+#include "shader_program.hpp"  // engine-internal: the engine's own compile-and-link
 
 namespace dyncull {
 namespace {
@@ -49,32 +50,16 @@ out vec4 fragColour;
 void main() { fragColour = vec4(0.8, 0.7, 0.6, 1.0); }
 )";
 
-GLuint compile(GLenum stage, const char* source) {
-    const GLuint s = glCreateShader(stage);
-    glShaderSource(s, 1, &source, nullptr);
-    glCompileShader(s);
-    GLint ok = 0;
-    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char log[1024] = {};
-        glGetShaderInfoLog(s, sizeof log, nullptr, log);
-        std::fprintf(stderr, "bench_draw_speed: shader: %s\n", log);
-        std::exit(1);
-    }
-    return s;
-}
-
 // The reference: the model's split mesh (positions only) drawn whole per object.
 class SpeedOfLight {
 public:
     explicit SpeedOfLight(const Engine& engine) {
-        program_ = glCreateProgram();
-        const GLuint vs = compile(GL_VERTEX_SHADER, kSolVertex), fs = compile(GL_FRAGMENT_SHADER, kSolFragment);
-        glAttachShader(program_, vs);
-        glAttachShader(program_, fs);
-        glLinkProgram(program_);
-        glDeleteShader(vs);
-        glDeleteShader(fs);
+        std::string log;
+        program_ = detail::buildProgram(kSolVertex, kSolFragment, log);
+        if (!program_) {
+            std::fprintf(stderr, "bench_draw_speed: shader: %s\n", log.c_str());
+            std::exit(1);
+        }
         locViewProj_ = glGetUniformLocation(program_, "uViewProj");
         locModel_ = glGetUniformLocation(program_, "uModel");
         const SceneObjects& objs = engine.objects();
