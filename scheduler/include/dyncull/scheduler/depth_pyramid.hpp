@@ -1,0 +1,70 @@
+// Farthest-depth pyramid (hierarchical Z) of a depth buffer, and the conservative test of a
+// screen rectangle against it: the cheap occlusion test of the two-phase method (draw last
+// frame's visible parts, build the pyramid from their depth, test everything else). Plain
+// C++ on a depth buffer read back from the GPU (or made by a test); no OpenGL.
+//
+// Conservative by construction, for any width and height (not only powers of two): texel
+// (x, y) of level k holds the farthest depth of exactly the level-0 pixels
+// [x 2^k, (x + 1) 2^k) x [y 2^k, (y + 1) 2^k) that lie on the screen, and a rectangle is
+// tested at the finest level where it spans at most 2 x 2 texels, so every pixel it touches
+// lies under one of the texels read (the step niagara and Bevy got wrong, see
+// ../shared/notes/batched-occlusion-tests.md).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "dyncull/scheduler/occupancy_map.hpp"
+
+namespace dyncull {
+
+/// Depths are window depths in dyncull's reversed-Z convention (objects/camera.hpp): 1 at
+/// the near plane, 0 at the far plane (and the cleared value), nearer is greater; the
+/// "farthest" of a set of depths is its minimum.
+class DepthPyramid {
+public:
+    /// Builds the pyramid of `depth`: width x height window depths, row by row from the
+    /// bottom row (as glReadPixels returns them). Reuses its memory across calls.
+    /// Preconditions (asserted): width, height >= 1, depth.size() == width * height.
+    void build(std::span<const float> depth, int width, int height);
+
+    int width() const { return width_; }
+    int height() const { return height_; }
+    int levels() const { return static_cast<int>(levels_.size()); }
+    /// Texel (x, y) of `level` (0 is the depth buffer itself); for tests and debug views.
+    float texel(int level, int x, int y) const;
+
+    /// Farthest depth over a superset of the pixels of `rect` (clamped to the screen): at
+    /// most four texel reads. An empty rectangle, or one wholly off screen, covers no pixel
+    /// and gives 1 (the near plane), the farthest of nothing.
+    float farthestIn(const ScreenRect& rect) const;
+
+    /// True only if a surface whose nearest window depth is `nearestDepth` and whose
+    /// fragments all fall inside `rect` is hidden at every pixel: it lies behind the
+    /// farthest depth of the rectangle by more than the rasteriser's rounding
+    /// (kDepthSlack). False for an empty or off-screen rectangle (no evidence either way)
+    /// and before the first build. The caller must have called the volume visible already if
+    /// it crosses the near plane (then it has no meaningful nearest depth).
+    bool occluded(const ScreenRect& rect, float nearestDepth) const;
+
+    /// Relative margin on depths: the GPU's depth of a surface point and the CPU's exact
+    /// depth of the volume around it differ by float rounding (a few ulp, 2^-23 each); the
+    /// margin is 2^-16 of the depth, far above that and far below any real separation.
+    static constexpr float kDepthSlack = 0x1p-16f;
+
+private:
+    struct Level {
+        std::size_t offset = 0;
+        int width = 0, height = 0;
+    };
+    std::vector<float> texels_;  // every level, level 0 first, each row-major from the bottom row
+    std::vector<Level> levels_;
+    int width_ = 0, height_ = 0;
+};
+
+/// The oracle: farthest depth over exactly the pixels of `rect` (clamped to the screen),
+/// by looking at each one; 1 for an empty or off-screen rectangle, as farthestIn.
+float farthestInBruteForce(std::span<const float> depth, int width, int height, const ScreenRect& rect);
+
+}  // namespace dyncull

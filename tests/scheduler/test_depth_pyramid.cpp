@@ -1,0 +1,136 @@
+// Depth pyramid against its brute-force oracle: on random and structured depth buffers of
+// awkward sizes, the pyramid's farthest depth over a rectangle is never nearer than the
+// exact farthest over its pixels (so it never calls a visible surface occluded), is exact
+// for rectangles of at most 2x2 pixels, and every texel covers exactly its pixel block.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <random>
+#include <vector>
+
+#include "dyncull/scheduler/depth_pyramid.hpp"
+
+namespace dyncull {
+namespace {
+
+struct Buffer {
+    int width, height;
+    std::vector<float> depth;
+};
+
+// Random depths in blocks of `block` pixels plus per-pixel noise, some pixels cleared to the
+// far plane (0) and some near (1), so minima come from single pixels anywhere.
+Buffer makeBuffer(int width, int height, int block, std::mt19937& rng) {
+    Buffer b{width, height, std::vector<float>(static_cast<std::size_t>(width) * static_cast<std::size_t>(height))};
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    const int bw = (width + block - 1) / block, bh = (height + block - 1) / block;
+    std::vector<float> blocks(static_cast<std::size_t>(bw) * static_cast<std::size_t>(bh));
+    for (float& v : blocks) v = u(rng);
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            float v = blocks[static_cast<std::size_t>(y / block) * static_cast<std::size_t>(bw) + static_cast<std::size_t>(x / block)];
+            v = std::clamp(v + 0.05f * (u(rng) - 0.5f), 0.0f, 1.0f);
+            const float r = u(rng);
+            if (r < 0.002f) v = 0.0f;        // background showing through
+            else if (r < 0.004f) v = 1.0f;   // at the near plane
+            b.depth[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)] = v;
+        }
+    return b;
+}
+
+ScreenRect randomRect(int width, int height, std::mt19937& rng) {
+    // Sizes from one pixel to more than the screen, positions partly off screen.
+    std::uniform_int_distribution<int> size(1, std::max(width, height) + 4);
+    std::uniform_int_distribution<int> small(1, 3);
+    const bool tiny = std::uniform_int_distribution<int>(0, 3)(rng) == 0;
+    const int w = tiny ? small(rng) : size(rng), h = tiny ? small(rng) : size(rng);
+    const int x0 = std::uniform_int_distribution<int>(-w + 1, width - 1)(rng);
+    const int y0 = std::uniform_int_distribution<int>(-h + 1, height - 1)(rng);
+    return {x0, y0, x0 + w, y0 + h};
+}
+
+TEST(DepthPyramid, NeverNearerThanTheExactFarthestAndExactForTinyRects) {
+    std::mt19937 rng(7);
+    const int sizes[][2] = {{1, 1}, {1, 7}, {7, 1}, {3, 5}, {64, 64}, {65, 33}, {257, 129}, {640, 360}};
+    std::uint64_t tests = 0, exact = 0;
+    for (const auto& s : sizes) {
+        for (const int block : {1, 4, 16}) {
+            const Buffer b = makeBuffer(s[0], s[1], block, rng);
+            DepthPyramid p;
+            p.build(b.depth, b.width, b.height);
+            for (int i = 0; i < 400; ++i) {
+                const ScreenRect r = randomRect(b.width, b.height, rng);
+                const float truth = farthestInBruteForce(b.depth, b.width, b.height, r);
+                const float fast = p.farthestIn(r);
+                ASSERT_LE(fast, truth) << s[0] << "x" << s[1] << " rect [" << r.x0 << "," << r.x1 << ")x[" << r.y0
+                                       << "," << r.y1 << ")";
+                if (r.x1 - r.x0 <= 2 && r.y1 - r.y0 <= 2) {
+                    EXPECT_EQ(fast, truth) << "a rectangle of at most 2x2 pixels is answered at level 0";
+                }
+                // A surface just in front of the exact farthest depth is visible somewhere in
+                // the rectangle; the pyramid must not call it occluded.
+                EXPECT_FALSE(p.occluded(r, truth)) << "at the farthest depth itself";
+                EXPECT_FALSE(p.occluded(r, std::nextafter(truth, 2.0f)));
+                ++tests;
+                exact += fast == truth;
+            }
+        }
+    }
+    // How often the 2x2-texel answer equals the exact one (not asserted: it depends on the data).
+    std::printf("depth pyramid: %llu rectangles, %.1f%% answered exactly\n", static_cast<unsigned long long>(tests),
+                100.0 * static_cast<double>(exact) / static_cast<double>(tests));
+}
+
+TEST(DepthPyramid, EveryTexelIsTheFarthestOfExactlyItsPixelBlock) {
+    std::mt19937 rng(11);
+    for (const auto& s : {std::pair{13, 9}, std::pair{640, 360}, std::pair{1, 33}}) {
+        const Buffer b = makeBuffer(s.first, s.second, 3, rng);
+        DepthPyramid p;
+        p.build(b.depth, b.width, b.height);
+        ASSERT_EQ(p.texel(0, 0, 0), b.depth[0]);
+        for (int k = 0; k < p.levels(); ++k) {
+            const int span = 1 << k;
+            for (int y = 0; y * span < b.height; ++y)
+                for (int x = 0; x * span < b.width; ++x) {
+                    const ScreenRect block{x * span, y * span, (x + 1) * span, (y + 1) * span};
+                    ASSERT_EQ(p.texel(k, x, y), farthestInBruteForce(b.depth, b.width, b.height, block))
+                        << "level " << k << " texel " << x << "," << y;
+                }
+        }
+        // The top level is one texel: the farthest depth of the whole buffer.
+        EXPECT_EQ(p.texel(p.levels() - 1, 0, 0), *std::min_element(b.depth.begin(), b.depth.end()));
+    }
+}
+
+TEST(DepthPyramid, OccludedOnlyBehindTheSlack) {
+    const int w = 40, h = 30;
+    std::vector<float> depth(static_cast<std::size_t>(w * h), 0.5f);
+    DepthPyramid p;
+    p.build(depth, w, h);
+    const ScreenRect r{5, 5, 20, 12};
+    EXPECT_FALSE(p.occluded(r, 0.5f)) << "a tie is visible";
+    EXPECT_FALSE(p.occluded(r, 0.5f * (1.0f - 0.5f * DepthPyramid::kDepthSlack))) << "within the rounding margin";
+    EXPECT_TRUE(p.occluded(r, 0.5f * (1.0f - 2.0f * DepthPyramid::kDepthSlack)));
+    EXPECT_TRUE(p.occluded(r, 0.1f));
+    // One pixel of background (cleared to the far plane) in the rectangle: nothing is hidden.
+    depth[static_cast<std::size_t>(8 * w + 17)] = 0.0f;
+    p.build(depth, w, h);
+    EXPECT_FALSE(p.occluded(r, 0.1f));
+    EXPECT_TRUE(p.occluded({0, 0, 3, 3}, 0.1f)) << "away from that pixel the rest still hides";
+}
+
+TEST(DepthPyramid, EmptyOrOffscreenRectanglesClaimNothing) {
+    std::vector<float> depth(64, 0.9f);
+    DepthPyramid p;
+    EXPECT_FALSE(p.occluded({0, 0, 4, 4}, 0.1f)) << "before the first build";
+    p.build(depth, 8, 8);
+    EXPECT_FALSE(p.occluded({3, 3, 3, 5}, 0.1f));    // empty
+    EXPECT_FALSE(p.occluded({9, 0, 12, 4}, 0.1f));   // right of the screen
+    EXPECT_FALSE(p.occluded({-5, -5, 0, 0}, 0.1f));  // below and left
+    EXPECT_TRUE(p.occluded({-5, -5, 1, 1}, 0.1f));   // reaches pixel (0, 0)
+    EXPECT_EQ(p.farthestIn({9, 9, 10, 10}), 1.0f);
+}
+
+}  // namespace
+}  // namespace dyncull
