@@ -288,7 +288,7 @@ void QueryScheduler::drawNode(NodeRef ref, bool untested) {
         sink_->drawPart(ref.object, n.firstIndex, n.indexCount);
         if (id != kNoQuery) {
             backend_->endDrawQuery(id);
-            drawQueries_.push_back({ref, id, {}, false});
+            drawQueries_.push_back(pendingOf(ref, id, {}, false));
             ++stats_->drawQueries;
         }
     } else {
@@ -419,6 +419,11 @@ void QueryScheduler::finishQuery(Pending& p, QueryResult r) {
         ++stats_->queriesOccluded;
 }
 
+QueryScheduler::Pending QueryScheduler::pendingOf(NodeRef ref, QueryId id, ScreenRect rect, bool batchedRect) const {
+    const std::uint32_t gen = ref.isSceneNode() ? 0 : tree_->objects().handle(ref.object).generation;
+    return {ref, id, rect, batchedRect, gen};
+}
+
 template <class OnAnswer>
 void QueryScheduler::takeAnswered(std::vector<Pending>& queries, OnAnswer onAnswer) {
     const SceneObjects& objs = tree_->objects();
@@ -430,8 +435,11 @@ void QueryScheduler::takeAnswered(std::vector<Pending>& queries, OnAnswer onAnsw
             continue;
         }
         backend_->release(p.id);
-        // The object may have been removed (or its slot reused) since the query was issued.
-        if (p.node.isSceneNode() || (p.node.object < objs.slotCount() && objs.alive(p.node.object)))
+        // The object may have been removed since the query was issued, and its slot reused
+        // by another object (of a model with fewer nodes, perhaps): only the same object's
+        // answer is recorded.
+        if (p.node.isSceneNode() || (p.node.object < objs.slotCount() && objs.alive(p.node.object) &&
+                                     objs.handle(p.node.object).generation == p.generation))
             onAnswer(history_.at(p.node, objs), r);
         queries[i] = queries.back();
         queries.pop_back();
@@ -496,7 +504,7 @@ void QueryScheduler::runFull() {
         ++stats_->queriesIssued;
         const bool marked = params_.useBatching;
         if (marked) pendingMap_.mark(rect);
-        pending_.push_back({ref, id, rect, marked});
+        pending_.push_back(pendingOf(ref, id, rect, marked));
         return true;
     };
 
@@ -590,7 +598,7 @@ void QueryScheduler::runFull() {
                     openBatch();
                     const QueryId id = timedIssue(queryVolume(ref, box));
                     ++stats_->queriesIssued;
-                    latent_.push_back({ref, id, rect, false});
+                    latent_.push_back(pendingOf(ref, id, rect, false));
                     h.queryInFlight = true;
                 }
                 if (h.answers > 0 && !h.lastVisible) {

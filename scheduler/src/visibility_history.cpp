@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cassert>
 
 namespace dyncull {
 
@@ -33,6 +34,7 @@ NodeHistory& VisibilityHistory::at(NodeRef ref, const SceneObjects& objects) {
         std::fill_n(objectNodes_.begin() + objectBase_[slot], nodes, NodeHistory{});
         objectGen_[slot] = gen;
     }
+    assert(ref.node < nodes && "a node of the object's current model");
     return objectNodes_[objectBase_[slot] + ref.node];
 }
 

@@ -792,3 +792,80 @@ TEST(QueryFaults, HungQueriesWithLastFrameResultsNeverCullAndNeverPileUp) {
     EXPECT_EQ(b.issued, issuedAfterFirst);  // bounded: one query per node at most
     EXPECT_EQ(b.waits, 0);
 }
+
+TEST(QueryFaults, AnswersForARemovedObjectAreDroppedWhenItsSlotIsReused) {
+    // Frame 1: spheres of a many-node model; with one-frame latency their queries are read
+    // in frame 2. In between every sphere is removed and its slot reused by a one-node cube
+    // in the same place. The late answers name the spheres' nodes: recorded for the cubes,
+    // they would say "occluded" for a cube never queried (and name nodes it does not have).
+    Mesh sphere;
+    const int slices = 24, stacks = 16;
+    for (int j = 0; j <= stacks; ++j)
+        for (int i = 0; i < slices; ++i) {
+            const float phi = 3.14159265f * float(j) / float(stacks), theta = 6.2831853f * float(i) / float(slices);
+            sphere.positions.push_back(0.3f * glm::vec3(std::sin(phi) * std::cos(theta), std::cos(phi), std::sin(phi) * std::sin(theta)));
+        }
+    test::appendSphereGridTriangles(sphere, slices, stacks);
+    LocalBspParams fine;
+    fine.maxLeafTriangles = 40;
+    auto sphereBsp = buildLocalBsp(sphere, fine);
+    ASSERT_TRUE(sphereBsp.ok());
+    ASSERT_GT(sphereBsp->nodes.size(), 8u);
+
+    SceneObjects objects;
+    const ModelId sphereModel = objects.addModel(sphereBsp.take());
+    const ModelId cube = objects.addModel(cubeModel(0.4f));
+    std::vector<Transform> places;
+    std::vector<ObjectHandle> handles;
+    for (int i = 0; i < 6; ++i) {
+        Transform t;
+        t.translation = {1.2f * static_cast<float>(i) - 3.0f, 0.0f, -4.0f};
+        places.push_back(t);
+        handles.push_back(objects.addObject(sphereModel, t).take());
+    }
+    LooseBsp bsp;
+    bsp.build(objects);
+
+    // The spheres' node volumes (at most 0.6 across) answer occluded; the loose-BSP cells
+    // around them and the cubes (0.8) answer visible.
+    ScriptedBackend b;
+    b.rule = [](const QueryVolume& v) {
+        glm::vec3 lo(1e30f), hi(-1e30f);
+        for (std::uint32_t i = 0; i < v.vertexCount; ++i) {
+            lo = glm::min(lo, v.vertices[i]);
+            hi = glm::max(hi, v.vertices[i]);
+        }
+        const glm::vec3 e = hi - lo;
+        return std::max({e.x, e.y, e.z}) < 0.65f ? QueryResult::Occluded : QueryResult::Visible;
+    };
+    SchedulerParams p;
+    p.useLastFrameResults = true;
+    p.useHistory = false;
+    p.useOccupancyAccept = false;
+    p.useDrawQueries = false;
+    QueryScheduler sched(p);
+    RecordingSink sink;
+    {
+        TwoLevelTree tree(bsp, objects);
+        sched.cullFrame(tree, frontCamera(), 640, 320, b, sink);
+    }
+    ASSERT_GT(b.issued, 6);
+
+    for (const ObjectHandle h : handles) ASSERT_TRUE(objects.removeObject(h).ok());
+    std::set<std::uint32_t> cubes;
+    for (const Transform& t : places) {
+        const ObjectHandle h = objects.addObject(cube, t).take();
+        cubes.insert(h.index);
+    }
+    ASSERT_EQ(cubes.size(), 6u);
+    for (const ObjectHandle h : handles) ASSERT_TRUE(cubes.count(h.index)) << "the test needs the slots reused";
+    bsp.update(objects);
+
+    sink.drawn.clear();
+    {
+        TwoLevelTree tree(bsp, objects);
+        sched.cullFrame(tree, frontCamera(), 640, 320, b, sink);
+    }
+    // Every cube is new: nothing known about it, so it is drawn while its query is in flight.
+    EXPECT_EQ(std::set<std::uint32_t>(sink.drawn.begin(), sink.drawn.end()), cubes);
+}

@@ -153,7 +153,12 @@ private:
         QueryId id;
         ScreenRect rect;
         bool batchedRect;  // rect is marked in pendingMap_
+        /// Generation of node.object when the query was issued: an answer that arrives after
+        /// the object was removed, and its slot perhaps reused by another model, is dropped.
+        std::uint32_t generation = 0;
     };
+    /// A pending query of `ref`, stamped with its object's current generation.
+    Pending pendingOf(NodeRef ref, QueryId id, ScreenRect rect, bool batchedRect) const;
     enum class FirstTest : std::uint8_t { Invisible, Visible, NeedQuery };
 
     FirstTest firstVisibilityTest(NodeRef ref, const Aabb& box, NodeHistory& h, FrameStats& st);
