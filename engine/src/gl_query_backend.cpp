@@ -179,6 +179,22 @@ void GlQueryBackend::endDrawQuery(QueryId id) {
     glEndQuery(queries_[id].target);
 }
 
+bool GlQueryBackend::readDepth(std::vector<float>& depth, int& width, int& height) {
+    const glm::ivec2 size = context_.size();
+    width = size.x;
+    height = size.y;
+    depth.resize(static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
+    GLint readFbo = 0, alignment = 4;
+    glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &readFbo);
+    glGetIntegerv(GL_PACK_ALIGNMENT, &alignment);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, context_.framebuffer());
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glReadPixels(0, 0, width, height, GL_DEPTH_COMPONENT, GL_FLOAT, depth.data());
+    glPixelStorei(GL_PACK_ALIGNMENT, alignment);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, static_cast<GLuint>(readFbo));
+    return true;
+}
+
 void GlQueryBackend::beginBatch() {
     assert(!inBatch_ && !inDrawQuery_);
     inBatch_ = true;
@@ -225,48 +241,15 @@ QueryId GlQueryBackend::issue(const QueryVolume& volume) {
     }
     if (degraded_) return answeredVisible();  // no buffer to draw the volume from: never culls, never waits
     // Vertices relative to the eye, the volume enlarged to cover the float rounding its
-    // world coordinates may carry: 2^-22 of the largest magnitude (2 ulp) per coordinate,
-    // so at most slack * sqrt(3) along any face normal. A volume 1e7 units from the origin
-    // is then never smaller than the geometry it bounds, and the query stays conservative.
-    glm::dvec3 centre(0.0);
-    double magnitude = 0.0;
-    for (std::uint32_t i = 0; i < nv; ++i) {
-        const glm::dvec3 v(volume.vertices[i]);
-        centre += v / double(nv);
-        magnitude = std::max({magnitude, std::abs(v.x), std::abs(v.y), std::abs(v.z)});
-    }
-    const double slack = magnitude * 0x1p-22, push = slack * std::sqrt(3.0);
-    // Scaling about the centre moves every face out by (k - 1) times its distance from the
-    // centre and keeps its normal, so k = 1 + push / (nearest face distance) moves each
-    // face out by at least `push` (a per-axis push would slide tilted faces along themselves).
-    double nearest = std::numeric_limits<double>::infinity();
-    const std::span<const std::uint8_t> tris = volume.triangles();
-    for (std::size_t t = 0; t + 2 < tris.size(); t += 3) {
-        const glm::dvec3 a(volume.vertices[tris[t]]), b(volume.vertices[tris[t + 1]]), c(volume.vertices[tris[t + 2]]);
-        const glm::dvec3 n = glm::cross(b - a, c - a);
-        const double len = glm::length(n);
-        if (len > 0.0) nearest = std::min(nearest, std::abs(glm::dot(n, a - centre)) / len);  // zero-area: no face
-    }
+    // world coordinates may carry, so a volume 1e7 units from the origin is never smaller
+    // than the geometry it bounds and the query stays conservative.
+    std::array<glm::dvec3, QueryVolume::kMaxVertices> relD;
+    bool asBox = false;
+    const std::uint32_t points = volume.enlargedForRounding(eye_, relD, asBox);
     std::array<glm::vec3, QueryVolume::kMaxVertices> rel;
-    // Thinner than a few roundings (e.g. collapsed flat by them): its vertices' axis-aligned
-    // box instead, each face pushed out along its axis; on an axis where the box is flat the
-    // corner's index bit says which side it belongs to.
-    const bool asBox = !(std::isfinite(nearest) && nearest > 4.0 * push);
-    if (asBox) {
-        glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
-        for (std::uint32_t i = 0; i < nv; ++i) {
-            lo = glm::min(lo, glm::dvec3(volume.vertices[i]));
-            hi = glm::max(hi, glm::dvec3(volume.vertices[i]));
-        }
-        for (std::uint32_t i = 0; i < 8; ++i)
-            rel[i] = glm::vec3(glm::dvec3((i & 1u) ? hi.x + push : lo.x - push, (i & 2u) ? hi.y + push : lo.y - push,
-                                          (i & 4u) ? hi.z + push : lo.z - push) - eye_);
-    } else {
-        const double k = 1.0 + push / nearest;
-        for (std::uint32_t i = 0; i < nv; ++i) rel[i] = glm::vec3(centre + (glm::dvec3(volume.vertices[i]) - centre) * k - eye_);
-    }
+    for (std::uint32_t i = 0; i < points; ++i) rel[i] = glm::vec3(relD[i]);
     const bool mesh = !asBox && !volume.isBox();
-    const std::uint32_t uploaded = asBox ? 8u : nv;
+    const std::uint32_t uploaded = points;
     // The scheduler queries no box near the near plane (QueryScheduler::projectRect), but
     // the enlargement may still carry a long volume across it: clipped there, it could
     // answer "occluded" for visible geometry, so it answers Visible without being drawn.

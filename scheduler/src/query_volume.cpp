@@ -4,6 +4,8 @@
 // "update the vertices of the original k-dop, and then render the same triangles").
 #include <algorithm>
 #include <cassert>
+#include <cmath>
+#include <limits>
 
 #include "dyncull/objects/convex_mesh.hpp"
 #include "dyncull/scheduler/query_backend.hpp"
@@ -41,6 +43,48 @@ QueryVolume QueryVolume::fromNodeVolume(const glm::mat4& objectToWorld, const No
     std::copy(tri.begin(), tri.end(), v.indices.begin());
     v.triangleCount = nv.triangleCount;
     return v;
+}
+
+std::uint32_t QueryVolume::enlargedForRounding(const glm::dvec3& eye, std::array<glm::dvec3, kMaxVertices>& out,
+                                               bool& asBox) const {
+    const std::uint32_t nv = vertexCount;
+    glm::dvec3 centre(0.0);
+    double magnitude = 0.0;
+    for (std::uint32_t i = 0; i < nv; ++i) {
+        const glm::dvec3 v(vertices[i]);
+        centre += v / double(nv);
+        magnitude = std::max({magnitude, std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+    }
+    const double slack = magnitude * 0x1p-22, push = slack * std::sqrt(3.0);
+    // Scaling about the centre moves every face out by (k - 1) times its distance from the
+    // centre and keeps its normal, so k = 1 + push / (nearest face distance) moves each
+    // face out by at least `push` (a per-axis push would slide tilted faces along themselves).
+    double nearest = std::numeric_limits<double>::infinity();
+    const std::span<const std::uint8_t> tris = triangles();
+    for (std::size_t t = 0; t + 2 < tris.size(); t += 3) {
+        const glm::dvec3 a(vertices[tris[t]]), b(vertices[tris[t + 1]]), c(vertices[tris[t + 2]]);
+        const glm::dvec3 n = glm::cross(b - a, c - a);
+        const double len = glm::length(n);
+        if (len > 0.0) nearest = std::min(nearest, std::abs(glm::dot(n, a - centre)) / len);  // zero-area: no face
+    }
+    // Thinner than a few roundings (e.g. collapsed flat by them): its vertices' axis-aligned
+    // box instead, each face pushed out along its axis; on an axis where the box is flat the
+    // corner's index bit says which side it belongs to.
+    asBox = !(std::isfinite(nearest) && nearest > 4.0 * push);
+    if (asBox) {
+        glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+        for (std::uint32_t i = 0; i < nv; ++i) {
+            lo = glm::min(lo, glm::dvec3(vertices[i]));
+            hi = glm::max(hi, glm::dvec3(vertices[i]));
+        }
+        for (std::uint32_t i = 0; i < 8; ++i)
+            out[i] = glm::dvec3((i & 1u) ? hi.x + push : lo.x - push, (i & 2u) ? hi.y + push : lo.y - push,
+                                (i & 4u) ? hi.z + push : lo.z - push) - eye;
+        return 8;
+    }
+    const double k = 1.0 + push / nearest;
+    for (std::uint32_t i = 0; i < nv; ++i) out[i] = centre + (glm::dvec3(vertices[i]) - centre) * k - eye;
+    return nv;
 }
 
 }  // namespace dyncull

@@ -44,6 +44,9 @@ public:
     std::uint64_t samples(QueryId id) const override;
     QueryId beginDrawQuery() override;
     void endDrawQuery(QueryId id) override;
+    /// glReadPixels of the context framebuffer's depth (waits for the drawing so far);
+    /// the read framebuffer binding and pack alignment are restored.
+    bool readDepth(std::vector<float>& depth, int& width, int& height) override;
 
     const GlQueryParams& params() const { return params_; }
     void setParams(const GlQueryParams& p) { params_ = p; }

@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -48,6 +49,15 @@ struct QueryVolume {
     /// `objectToWorld`: vertices transformed, triangles kept (k-DOP paper, section 3.3).
     /// An empty node volume gives an empty box (vertexCount 0) — callers query such nodes by AABB.
     static QueryVolume fromNodeVolume(const glm::mat4& objectToWorld, const NodeVolumes& volumes, const NodeVolume& v);
+
+    /// The volume grown to cover the float rounding its world coordinates may carry (2 ulp,
+    /// 2^-22 of the largest magnitude, per coordinate), as points relative to `eye` in
+    /// double: scaled about its centre so that every face moves out by at least that much;
+    /// or, thinner than a few roundings, the 8 corners of its vertices' box, each face
+    /// pushed out along its axis (`asBox` is then set). Returns the number of points
+    /// written. What a backend draws and a CPU test projects, so neither is ever smaller
+    /// than the geometry the volume bounds, at 1e7 from the origin too.
+    std::uint32_t enlargedForRounding(const glm::dvec3& eye, std::array<glm::dvec3, kMaxVertices>& out, bool& asBox) const;
 };
 
 using QueryId = std::uint32_t;
@@ -87,6 +97,14 @@ public:
     /// cannot (the default), and the scheduler then relies on visibility history alone.
     virtual QueryId beginDrawQuery() { return kNoQuery; }
     virtual void endDrawQuery(QueryId) {}
+    /// Reads the depth of everything drawn so far this frame into `depth` (width x height
+    /// window depths, reversed Z, rows from the bottom; resized as needed), waiting for
+    /// the drawing to finish. false if the backend cannot (the default): the two-phase mode
+    /// then culls nothing by occlusion.
+    virtual bool readDepth(std::vector<float>& depth, int& width, int& height) {
+        (void)depth, (void)width, (void)height;
+        return false;
+    }
 };
 
 /// What the scheduler calls to draw an object part: slot `object` of SceneObjects, the
