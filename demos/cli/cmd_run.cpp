@@ -193,7 +193,7 @@ void registerRun(CLI::App& app) {
     auto o = std::make_shared<RunOptions>();
     CLI::App* cmd = app.add_subcommand("run", "Play a scene's camera path with one culling mode (headless by default)");
     cmd->add_option("scene", o->scene, "bunnies, powerplant, city, a directory of .ply/.obj parts, a .ply/.obj/.gltf/.glb file, or a .dsub file from dyncull subdivide")->capture_default_str();
-    cmd->add_option("--mode", o->mode, "vfc, simple or full")->capture_default_str();
+    cmd->add_option("--mode", o->mode, "vfc, simple, full or twophase")->capture_default_str();
     cmd->add_option("--frames", o->frames, "frames to run (default: the scene's camera path once)")
         ->check(wholeIn(1, kMaxFrames));
     cmd->add_option("--size", o->size, "framebuffer size WxH")->capture_default_str();

@@ -1,6 +1,6 @@
 // Farthest-depth pyramid: each level halves the previous one (rounding up), a texel taking
 // the minimum (farthest, reversed Z) of the up-to-2x2 texels below it that exist; a
-// rectangle is answered at the finest level where it spans at most 2x2 texels.
+// rectangle is answered at the finest level where it spans at most kMaxSpan texels a side.
 #include "dyncull/scheduler/depth_pyramid.hpp"
 
 #include <algorithm>
@@ -65,13 +65,18 @@ float DepthPyramid::texel(int level, int x, int y) const {
 float DepthPyramid::farthestIn(const ScreenRect& rect) const {
     int x0, y0, x1, y1;
     if (levels_.empty() || !clampRect(rect, width_, height_, x0, y0, x1, y1)) return 1.0f;
-    // The finest level where the rectangle's first and last pixels fall in the same or
-    // neighbouring texels on both axes; at the top level (1x1) they always do.
+    // The finest level where the rectangle spans at most kMaxSpan texels on both axes (at
+    // the top level, 1x1, it always does); every texel it touches there is read.
     int k = 0;
-    while ((x1 >> k) - (x0 >> k) > 1 || (y1 >> k) - (y0 >> k) > 1) ++k;
+    while ((x1 >> k) - (x0 >> k) >= kMaxSpan || (y1 >> k) - (y0 >> k) >= kMaxSpan) ++k;
     assert(k < levels());
-    const int tx0 = x0 >> k, ty0 = y0 >> k, tx1 = x1 >> k, ty1 = y1 >> k;
-    return std::min({texel(k, tx0, ty0), texel(k, tx1, ty0), texel(k, tx0, ty1), texel(k, tx1, ty1)});
+    const Level& l = levels_[static_cast<std::size_t>(k)];
+    float farthest = 1.0f;
+    for (int ty = y0 >> k; ty <= (y1 >> k); ++ty) {
+        const float* row = texels_.data() + l.offset + static_cast<std::size_t>(ty) * static_cast<std::size_t>(l.width);
+        for (int tx = x0 >> k; tx <= (x1 >> k); ++tx) farthest = std::min(farthest, row[tx]);
+    }
+    return farthest;
 }
 
 bool DepthPyramid::occluded(const ScreenRect& rect, float nearestDepth) const {

@@ -24,6 +24,7 @@ const char* toString(CullMode m) {
         case CullMode::Vfc: return "vfc";
         case CullMode::Simple: return "simple";
         case CullMode::Full: return "full";
+        case CullMode::TwoPhase: return "twophase";
     }
     return "?";
 }
@@ -47,7 +48,8 @@ Expected<CullMode> parseCullMode(const std::string& s) {
     if (s == "vfc") return CullMode::Vfc;
     if (s == "simple") return CullMode::Simple;
     if (s == "full") return CullMode::Full;
-    return Error{"unknown mode '" + s + "' (expected vfc, simple or full)"};
+    if (s == "twophase") return CullMode::TwoPhase;
+    return Error{"unknown mode '" + s + "' (expected vfc, simple, full or twophase)"};
 }
 
 Status validateSchedulerParams(const SchedulerParams& p) {
@@ -113,8 +115,9 @@ FrameStats QueryScheduler::cullFrame(const TwoLevelTree& tree, const Camera& cam
         case CullMode::Vfc: runVfc(); break;
         case CullMode::Simple: runSimple(); break;
         case CullMode::Full: runFull(); break;
+        case CullMode::TwoPhase: runTwoPhase(); break;
     }
-    st.traversalMs = std::max(0.0, msSince(t0) - st.waitMs - st.drawMs - st.queryMs);
+    st.traversalMs = std::max(0.0, msSince(t0) - st.waitMs - st.drawMs - st.queryMs - st.depthReadMs);
     stats_ = nullptr;
     return st;
 }

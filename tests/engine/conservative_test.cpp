@@ -1,6 +1,6 @@
 // The key correctness test of the culling modes: on a small moving swarm (a bumpy
 // procedural blob written as a PLY, so no data files are needed), every conservative mode
-// — simple, full and each ablation of full — draws the same image as vfc (at most 0.01%
+// — simple, full, each ablation of full and twophase — draws the same image as vfc (at most 0.01%
 // of pixels differ) with no visible part missing against the ID-pass ground truth and no
 // stalled query, on every frame. The oracle draws exactly the visible set and must match
 // too; a large pixel threshold must show up as false negatives (the measurement sees errors).
@@ -94,7 +94,7 @@ protected:
 TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
     ASSERT_NO_FATAL_FAILURE(build("dyncull_conservative_", 30));
 
-    const char* conservative = "vfc,simple,full,full-nohist,full-nobatch,full-noocc,full-notight,full-nodrawq,order,front10,oracle,thr64";
+    const char* conservative = "vfc,simple,full,full-nohist,full-nobatch,full-noocc,full-notight,full-nodrawq,order,front10,twophase,oracle,thr64";
     auto modes = cli::modesFromList(conservative);
     ASSERT_TRUE(modes.ok()) << modes.error().message;
     // The test checks culling, not latency: a query that outlasts the default 250 ms bound
@@ -185,7 +185,7 @@ TEST(Conservative, SubdividedStaticModelsDrawTheVfcImage) {
             ASSERT_TRUE((*scene)->populate(engine).ok());
             EXPECT_EQ(engine.objects().objectCount(), saved->subdivision.stats.leaves);
             EXPECT_GE(saved->subdivision.stats.leaves, 9216u / 500u);
-            auto modes = cli::modesFromList("vfc,full,front10");
+            auto modes = cli::modesFromList("vfc,full,front10,twophase");
             ASSERT_TRUE(modes.ok());
             auto runner = cli::BenchRunner::create(engine, **scene, modes.take());
             ASSERT_TRUE(runner.ok()) << runner.error().message;

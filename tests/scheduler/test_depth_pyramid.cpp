@@ -1,7 +1,7 @@
 // Depth pyramid against its brute-force oracle: on random and structured depth buffers of
 // awkward sizes, the pyramid's farthest depth over a rectangle is never nearer than the
 // exact farthest over its pixels (so it never calls a visible surface occluded), is exact
-// for rectangles of at most 2x2 pixels, and every texel covers exactly its pixel block.
+// for rectangles of at most kMaxSpan pixels a side, and every texel covers exactly its pixel block.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -50,7 +50,7 @@ ScreenRect randomRect(int width, int height, std::mt19937& rng) {
     return {x0, y0, x0 + w, y0 + h};
 }
 
-TEST(DepthPyramid, NeverNearerThanTheExactFarthestAndExactForTinyRects) {
+TEST(DepthPyramid, NeverNearerThanTheExactFarthestAndExactForSmallRects) {
     std::mt19937 rng(7);
     const int sizes[][2] = {{1, 1}, {1, 7}, {7, 1}, {3, 5}, {64, 64}, {65, 33}, {257, 129}, {640, 360}};
     std::uint64_t tests = 0, exact = 0;
@@ -65,8 +65,8 @@ TEST(DepthPyramid, NeverNearerThanTheExactFarthestAndExactForTinyRects) {
                 const float fast = p.farthestIn(r);
                 ASSERT_LE(fast, truth) << s[0] << "x" << s[1] << " rect [" << r.x0 << "," << r.x1 << ")x[" << r.y0
                                        << "," << r.y1 << ")";
-                if (r.x1 - r.x0 <= 2 && r.y1 - r.y0 <= 2) {
-                    EXPECT_EQ(fast, truth) << "a rectangle of at most 2x2 pixels is answered at level 0";
+                if (r.x1 - r.x0 <= DepthPyramid::kMaxSpan && r.y1 - r.y0 <= DepthPyramid::kMaxSpan) {
+                    EXPECT_EQ(fast, truth) << "a rectangle of at most kMaxSpan pixels a side is answered at level 0";
                 }
                 // A surface just in front of the exact farthest depth is visible somewhere in
                 // the rectangle; the pyramid must not call it occluded.

@@ -6,9 +6,9 @@
 // Conservative by construction, for any width and height (not only powers of two): texel
 // (x, y) of level k holds the farthest depth of exactly the level-0 pixels
 // [x 2^k, (x + 1) 2^k) x [y 2^k, (y + 1) 2^k) that lie on the screen, and a rectangle is
-// tested at the finest level where it spans at most 2 x 2 texels, so every pixel it touches
-// lies under one of the texels read (the step niagara and Bevy got wrong, see
-// ../shared/notes/batched-occlusion-tests.md).
+// tested at the finest level where it spans at most kMaxSpan texels a side, reading every
+// texel it touches, so every pixel it covers lies under a texel read (the step niagara and
+// Bevy got wrong, see ../shared/notes/batched-occlusion-tests.md).
 #pragma once
 
 #include <cstdint>
@@ -35,8 +35,13 @@ public:
     /// Texel (x, y) of `level` (0 is the depth buffer itself); for tests and debug views.
     float texel(int level, int x, int y) const;
 
+    /// Texels a tested rectangle may span per axis. 2 is the classic HZB test (four reads);
+    /// 4 reads up to 16 texels of a level two steps finer, a bound on 1/4 of the area
+    /// around the rectangle, which culls the swarm's small parts far better.
+    static constexpr int kMaxSpan = 4;
+
     /// Farthest depth over a superset of the pixels of `rect` (clamped to the screen): at
-    /// most four texel reads. An empty rectangle, or one wholly off screen, covers no pixel
+    /// most kMaxSpan^2 texel reads. An empty rectangle, or one wholly off screen, covers no pixel
     /// and gives 1 (the near plane), the farthest of nothing.
     float farthestIn(const ScreenRect& rect) const;
 

@@ -13,6 +13,8 @@ struct FrameStats {
     double frameMs = 0.0;      ///< whole frame including the final glFinish
     double updateMs = 0.0;     ///< loose-BSP relink and lazy rebuild
     std::uint32_t queriesIssued = 0;
+    std::uint32_t depthTests = 0;    ///< two-phase: nodes tested against the depth pyramid
+    double depthReadMs = 0.0;        ///< two-phase: reading the depth back (waits for the early pass) and building the pyramid
     std::uint64_t queryTriangles = 0;   ///< triangles of the query volumes drawn (12 per box)
     std::uint32_t queriesOccluded = 0;  ///< answered "occluded"
     std::uint32_t queriesTimedOut = 0;  ///< never answered within the bound; counted visible

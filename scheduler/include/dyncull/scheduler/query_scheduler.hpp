@@ -15,6 +15,7 @@
 #include "dyncull/objects/error.hpp"
 #include "dyncull/objects/volume_kind.hpp"
 #include "dyncull/scheduler/frame_stats.hpp"
+#include "dyncull/scheduler/depth_pyramid.hpp"
 #include "dyncull/scheduler/occupancy_map.hpp"
 #include "dyncull/scheduler/query_backend.hpp"
 #include "dyncull/scheduler/visibility_history.hpp"
@@ -25,6 +26,10 @@ enum class CullMode : std::uint8_t {
     Vfc,     ///< frustum culling only
     Simple,  ///< the paper's Simple OC: one stop-and-wait query per node in the frustum
     Full,    ///< everything below, each feature switchable for ablation
+    /// Two-phase method of GPU-driven engines: draw last frame's visible parts, read the
+    /// depth back into a farthest-depth pyramid, test every node against it on the CPU,
+    /// draw what is newly visible (QueryBackend::readDepth; without it nothing is culled).
+    TwoPhase,
 };
 const char* toString(CullMode m);
 Expected<CullMode> parseCullMode(const std::string& s);
@@ -179,6 +184,12 @@ private:
     void runVfc();
     void runSimple();
     void runFull();
+    void runTwoPhase();  // two_phase.cpp
+    /// The box's screen rectangle and its nearest window depth (reversed Z, the largest of
+    /// its corners'); false if it crosses the near plane (then it is simply visible).
+    bool projectRectDepth(const Aabb& box, ScreenRect& rect, float& nearestDepth) const;
+    /// The same for a query volume (grown by its vertices' rounding).
+    bool projectVolumeDepth(const QueryVolume& volume, ScreenRect& rect, float& nearestDepth) const;
 
     SchedulerParams params_;
     VisibilityHistory history_;
@@ -203,6 +214,9 @@ private:
     std::vector<NodeTrace>* trace_ = nullptr;
     // useLastFrameResults: queries issued in an earlier frame, read when they answer.
     std::vector<Pending> latent_;
+    // TwoPhase: the early pass's depth and its pyramid, reused across frames.
+    std::vector<float> depth_;
+    DepthPyramid pyramid_;
     // useDrawQueries: this frame's draw queries, and last frame's not yet read.
     std::vector<Pending> drawQueries_, drawAnswers_;
 

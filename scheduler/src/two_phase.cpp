@@ -1,0 +1,163 @@
+// Two-phase occlusion culling, the method of current GPU-driven engines (niagara, UE5
+// Nanite, Bevy; see ../shared/notes/batched-occlusion-tests.md), on the two-level tree:
+//  1. early pass: the parts visible last frame are drawn, frustum-culled;
+//  2. their depth is read back into a farthest-depth pyramid (DepthPyramid);
+//  3. late pass: the tree is traversed front to back, every node tested against the
+//     pyramid (a rectangle and a depth, a few nanoseconds); an occluded node's subtree is
+//     skipped, a visible part not drawn in the early pass is drawn now; the outcome is
+//     next frame's early set.
+// Conservative: whatever is not drawn was hidden behind depth that the final image also
+// has (the early parts are drawn, and depth only grows nearer afterwards).
+#include <algorithm>
+#include <array>
+#include <cassert>
+#include <chrono>
+#include <cmath>
+
+#include "dyncull/scheduler/query_scheduler.hpp"
+
+namespace dyncull {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+}  // namespace
+
+bool QueryScheduler::projectRectDepth(const Aabb& box, ScreenRect& rect, float& nearestDepth) const {
+    if (!projectRect(box, rect)) return false;
+    // Window depth of a point in front of the near plane is clip z / w (reversed Z, zero
+    // to one, no remap: objects/camera.hpp); the nearest corner has the largest.
+    const glm::dvec3 eye(camera_.position);
+    double nearest = 0.0;
+    for (int i = 0; i < 8; ++i) {
+        const glm::dvec3 c((i & 1) ? box.max.x : box.min.x, (i & 2) ? box.max.y : box.min.y, (i & 4) ? box.max.z : box.min.z);
+        const glm::dvec4 clip = viewProj_ * glm::dvec4(c - eye, 1.0);
+        if (clip.w > 0.0) nearest = std::max(nearest, clip.z / clip.w);
+    }
+    nearestDepth = static_cast<float>(nearest);
+    return true;
+}
+
+bool QueryScheduler::projectVolumeDepth(const QueryVolume& volume, ScreenRect& rect, float& nearestDepth) const {
+    // The volume grown by the rounding of its float vertices, projected in double; any
+    // point within the near-plane margin makes it "crossing" (visible), as in projectRect.
+    std::array<glm::dvec3, QueryVolume::kMaxVertices> rel;
+    bool asBox = false;
+    const std::uint32_t n = volume.enlargedForRounding(glm::dvec3(camera_.position), rel, asBox);
+    double magnitude = 0.0;
+    for (std::uint32_t i = 0; i < n; ++i)
+        magnitude = std::max({magnitude, std::abs(rel[i].x), std::abs(rel[i].y), std::abs(rel[i].z)});
+    const double nearPlane = double(camera_.nearPlane);
+    const double nearTest = nearPlane + 0x1p-21 * magnitude + 0x1p-22 * nearPlane;
+    glm::dvec2 lo(1e300), hi(-1e300);
+    double nearest = 0.0;
+    for (std::uint32_t i = 0; i < n; ++i) {
+        const glm::dvec4 clip = viewProj_ * glm::dvec4(rel[i], 1.0);
+        if (clip.w < nearTest) return false;
+        const glm::dvec2 ndc = glm::dvec2(clip) / clip.w;
+        lo = glm::min(lo, ndc);
+        hi = glm::max(hi, ndc);
+        nearest = std::max(nearest, clip.z / clip.w);
+    }
+    // Pixels rounded outwards and padded by one, as projectRect.
+    const double fx = 0.5 * width_, fy = 0.5 * height_;
+    auto clampi = [](double v, int lim) { return static_cast<int>(std::clamp(v, 0.0, static_cast<double>(lim))); };
+    rect.x0 = clampi(std::floor((lo.x + 1.0) * fx) - 1.0, width_);
+    rect.y0 = clampi(std::floor((lo.y + 1.0) * fy) - 1.0, height_);
+    rect.x1 = clampi(std::ceil((hi.x + 1.0) * fx) + 1.0, width_);
+    rect.y1 = clampi(std::ceil((hi.y + 1.0) * fy) + 1.0, height_);
+    nearestDepth = static_cast<float>(nearest);
+    return true;
+}
+
+void QueryScheduler::runTwoPhase() {
+    const SceneObjects& objs = tree_->objects();
+    const NodeRef root = active_.empty() ? NodeRef{} : active_.back();
+
+    // 1. Early pass. lastTouchedFrame marks a part drawn in it.
+    while (!active_.empty()) {
+        const NodeRef ref = active_.back();
+        active_.pop_back();
+        ++stats_->nodesVisited;
+        if (frustum_.outside(tree_->worldBox(ref))) continue;
+        NodeHistory& h = history_.at(ref, objs);
+        if (!tree_->isDrawable(ref)) {
+            scratch_.clear();
+            tree_->expand(ref, camera_.position, scratch_);
+            for (auto it = scratch_.rbegin(); it != scratch_.rend(); ++it) active_.push_back(*it);
+            continue;
+        }
+        if (h.lastVisible && h.lastVisibleFrame + 1 == frame_) {
+            trace(ref, tree_->worldBox(ref), NodeState::VisibleHistory);  // drawn untested
+            drawNode(ref, false);
+            h.lastTouchedFrame = frame_;
+        }
+    }
+
+    // 2. The early pass's depth. A backend that cannot read depth leaves the pyramid
+    // unbuilt, and an unbuilt pyramid calls nothing occluded.
+    const auto t0 = Clock::now();
+    int w = 0, hgt = 0;
+    const bool haveDepth = backend_->readDepth(depth_, w, hgt) && w == width_ && hgt == height_;
+    if (haveDepth) pyramid_.build(depth_, w, hgt);
+    stats_->depthReadMs += msSince(t0);
+
+    // 3. Late pass.
+    if (!(root == NodeRef{})) active_.push_back(root);
+    while (!active_.empty()) {
+        const NodeRef ref = active_.back();
+        active_.pop_back();
+        ++stats_->nodesVisited;
+        const Aabb box = tree_->worldBox(ref);
+        NodeHistory& h = history_.at(ref, objs);
+        // A part drawn in the early pass is still tested (for next frame) but was decided
+        // there: its trace entry is the early one.
+        const bool drawnEarly = tree_->isDrawable(ref) && h.lastTouchedFrame == frame_;
+        auto note = [&](NodeState state) {
+            if (!drawnEarly) trace(ref, box, state);
+        };
+        if (frustum_.outside(box)) {
+            ++stats_->frustumCulled;
+            h.lastVisible = false;
+            note(NodeState::FrustumCulled);
+            continue;
+        }
+        ScreenRect rect;
+        float nearest = 1.0f;
+        // Object nodes by their own volume (a transformed box or k-DOP, tighter than the
+        // world box of a rotated part), scene nodes by their box.
+        const bool inFront = ref.isSceneNode() || !params_.useTightVolumes
+                                 ? projectRectDepth(box, rect, nearest)
+                                 : projectVolumeDepth(objectNodeVolume(objs, ref, params_.volume, params_.autoVolumeSaving),
+                                                      rect, nearest);
+        if (!inFront || box.contains(camera_.position)) {
+            ++stats_->visibleNearOrInside;
+            note(NodeState::VisibleNear);
+        } else if (rect.empty()) {
+            ++stats_->frustumCulled;
+            h.lastVisible = false;
+            note(NodeState::FrustumCulled);
+            continue;
+        } else {
+            ++stats_->depthTests;
+            if (haveDepth && pyramid_.occluded(rect, nearest)) {
+                ++stats_->queriesOccluded;
+                h.lastVisible = false;
+                note(NodeState::Occluded);
+                continue;
+            }
+            note(NodeState::VisibleQueried);
+        }
+        h.lastVisible = true;
+        h.lastVisibleFrame = frame_;
+        if (tree_->isDrawable(ref)) {
+            if (!drawnEarly) drawNode(ref, false);
+            continue;
+        }
+        scratch_.clear();
+        tree_->expand(ref, camera_.position, scratch_);
+        for (auto it = scratch_.rbegin(); it != scratch_.rend(); ++it) active_.push_back(*it);
+    }
+}
+
+}  // namespace dyncull
