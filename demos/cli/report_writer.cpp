@@ -97,6 +97,8 @@ std::vector<ModeSummary> summarise(const BenchResult& r) {
             s.fpOther += f.falsePositiveCauses.other;
             s.drawQueries += f.stats.drawQueries;
             s.drawQueriesOccluded += f.stats.drawQueriesOccluded;
+            s.depthTests += f.stats.depthTests;
+            s.depthReadMs += f.stats.depthReadMs;
             s.largestRegion = std::max(s.largestRegion, f.image.largestRegion);
             s.timeouts += f.stats.queriesTimedOut;
         }
@@ -106,7 +108,8 @@ std::vector<ModeSummary> summarise(const BenchResult& r) {
         s.msMean /= n;
         for (double* v : {&s.traversalMs, &s.queryMs, &s.waitMs, &s.drawMs, &s.parts, &s.triangles, &s.queries, &s.occluded,
                           &s.skippedHistory, &s.skippedOccupancy, &s.batches, &s.pctWrongMean, &s.falsePositives, &s.fpQueried,
-                          &s.fpHistory, &s.fpOccupancy, &s.fpOther, &s.drawQueries, &s.drawQueriesOccluded})
+                          &s.fpHistory, &s.fpOccupancy, &s.fpOther, &s.drawQueries, &s.drawQueriesOccluded, &s.depthTests,
+                          &s.depthReadMs})
             *v /= n;
         std::sort(ms.begin(), ms.end());
         s.msMin = ms.front();
@@ -172,7 +175,7 @@ Status writeFramesCsv(const BenchResult& r, const fs::path& path) {
          "pixels_wrong,pixels_wrong_pct,largest_wrong_region,frame_update_ms,ground_truth_ms,ground_truth_artefact_pixels,"
          "draw_queries,draw_queries_occluded,draw_queries_late,false_positives_queried,false_positives_history,"
          "false_positives_occupancy,false_positives_other,visible_triangles,bound_aabb_parts,bound_aabb_triangles,"
-         "bound_auto_parts,bound_auto_triangles\n";
+         "bound_auto_parts,bound_auto_triangles,depth_tests,ms_depth_read\n";
     for (std::size_t i = 0; i < r.frames.size(); ++i) {
         const FrameTruth& t = r.truth[i];
         for (std::size_t m = 0; m < r.modes.size(); ++m) {
@@ -192,9 +195,10 @@ Status writeFramesCsv(const BenchResult& r, const fs::path& path) {
             f << c.queried << ',' << c.history << ',' << c.occupancy << ',' << c.other << ',' << t.visibleTriangles;
             if (t.boundMeasured)
                 f << ',' << t.boundAabb.parts << ',' << t.boundAabb.triangles << ',' << t.boundAuto.parts << ','
-                  << t.boundAuto.triangles << '\n';
+                  << t.boundAuto.triangles;
             else
-                f << ",,,,\n";  // not measured
+                f << ",,,,";  // not measured
+            f << ',' << s.depthTests << ',' << s.depthReadMs << '\n';
         }
     }
     return closeChecked(f, path);
@@ -208,7 +212,8 @@ Status writeSummaryCsv(const std::vector<ModeSummary>& summary, const fs::path& 
          "pixels_wrong_pct_max,frames_wrong,false_negatives,false_negative_pixels,false_positives_per_frame,"
          "largest_wrong_region,timeouts,pareto,volume,pct_parts_culled,query_triangles,leaf_volume,"
          "leaf_surface_area,leaf_triangles_mean,leaf_triangles_max,paired_vs_best,false_positives_queried,"
-         "false_positives_history,false_positives_occupancy,false_positives_other,draw_queries,draw_queries_occluded\n";
+         "false_positives_history,false_positives_occupancy,false_positives_other,draw_queries,draw_queries_occluded,"
+         "depth_tests,ms_depth_read\n";
     for (const ModeSummary& s : summary)
         f << s.name << ',' << s.frames << ',' << s.msMean << ',' << s.msMedian << ',' << s.msMin << ',' << s.msMax
           << ',' << s.traversalMs << ',' << s.queryMs << ',' << s.waitMs << ',' << s.drawMs << ',' << s.ratioVfc << ',' << s.ratioOracle
@@ -219,7 +224,8 @@ Status writeSummaryCsv(const std::vector<ModeSummary>& summary, const fs::path& 
           << s.pctPartsCulled << ',' << s.queryTriangles << ',' << s.leaves.volume << ',' << s.leaves.surfaceArea << ','
           << (s.leaves.leaves ? static_cast<double>(s.leaves.triangles) / static_cast<double>(s.leaves.leaves) : 0.0)
           << ',' << s.leaves.maxTriangles << ',' << s.pairedVsBest << ',' << s.fpQueried << ',' << s.fpHistory << ','
-          << s.fpOccupancy << ',' << s.fpOther << ',' << s.drawQueries << ',' << s.drawQueriesOccluded << '\n';
+          << s.fpOccupancy << ',' << s.fpOther << ',' << s.drawQueries << ',' << s.drawQueriesOccluded << ','
+          << s.depthTests << ',' << s.depthReadMs << '\n';
     return closeChecked(f, path);
 }
 

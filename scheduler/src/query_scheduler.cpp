@@ -202,15 +202,17 @@ bool QueryScheduler::projectRect(const Aabb& box, ScreenRect& out) const {
         out = {};
         return !crosses;
     }
+    out = pixelRect(lo, hi);
+    return !crosses;
+}
+
+ScreenRect QueryScheduler::pixelRect(const glm::dvec2& lo, const glm::dvec2& hi) const {
     // Pixels, rounded outwards and padded by one so rasterisation rules never leave a
     // covered pixel outside the rectangle.
     const double fx = 0.5 * width_, fy = 0.5 * height_;
     auto clampi = [](double v, int lim) { return static_cast<int>(std::clamp(v, 0.0, static_cast<double>(lim))); };
-    out.x0 = clampi(std::floor((lo.x + 1.0) * fx) - 1.0, width_);
-    out.y0 = clampi(std::floor((lo.y + 1.0) * fy) - 1.0, height_);
-    out.x1 = clampi(std::ceil((hi.x + 1.0) * fx) + 1.0, width_);
-    out.y1 = clampi(std::ceil((hi.y + 1.0) * fy) + 1.0, height_);
-    return !crosses;
+    return {clampi(std::floor((lo.x + 1.0) * fx) - 1.0, width_), clampi(std::floor((lo.y + 1.0) * fy) - 1.0, height_),
+            clampi(std::ceil((hi.x + 1.0) * fx) + 1.0, width_), clampi(std::ceil((hi.y + 1.0) * fy) + 1.0, height_)};
 }
 
 QueryScheduler::FirstTest QueryScheduler::firstVisibilityTest(NodeRef ref, const Aabb& box, NodeHistory& h,

@@ -23,21 +23,6 @@ using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 }  // namespace
 
-bool QueryScheduler::projectRectDepth(const Aabb& box, ScreenRect& rect, float& nearestDepth) const {
-    if (!projectRect(box, rect)) return false;
-    // Window depth of a point in front of the near plane is clip z / w (reversed Z, zero
-    // to one, no remap: objects/camera.hpp); the nearest corner has the largest.
-    const glm::dvec3 eye(camera_.position);
-    double nearest = 0.0;
-    for (int i = 0; i < 8; ++i) {
-        const glm::dvec3 c((i & 1) ? box.max.x : box.min.x, (i & 2) ? box.max.y : box.min.y, (i & 4) ? box.max.z : box.min.z);
-        const glm::dvec4 clip = viewProj_ * glm::dvec4(c - eye, 1.0);
-        if (clip.w > 0.0) nearest = std::max(nearest, clip.z / clip.w);
-    }
-    nearestDepth = static_cast<float>(nearest);
-    return true;
-}
-
 bool QueryScheduler::projectVolumeDepth(const QueryVolume& volume, ScreenRect& rect, float& nearestDepth) const {
     // The volume grown by the rounding of its float vertices, projected in double; any
     // point within the near-plane margin makes it "crossing" (visible), as in projectRect.
@@ -59,13 +44,7 @@ bool QueryScheduler::projectVolumeDepth(const QueryVolume& volume, ScreenRect& r
         hi = glm::max(hi, ndc);
         nearest = std::max(nearest, clip.z / clip.w);
     }
-    // Pixels rounded outwards and padded by one, as projectRect.
-    const double fx = 0.5 * width_, fy = 0.5 * height_;
-    auto clampi = [](double v, int lim) { return static_cast<int>(std::clamp(v, 0.0, static_cast<double>(lim))); };
-    rect.x0 = clampi(std::floor((lo.x + 1.0) * fx) - 1.0, width_);
-    rect.y0 = clampi(std::floor((lo.y + 1.0) * fy) - 1.0, height_);
-    rect.x1 = clampi(std::ceil((hi.x + 1.0) * fx) + 1.0, width_);
-    rect.y1 = clampi(std::ceil((hi.y + 1.0) * fy) + 1.0, height_);
+    rect = pixelRect(lo, hi);
     nearestDepth = static_cast<float>(nearest);
     return true;
 }
@@ -125,11 +104,12 @@ void QueryScheduler::runTwoPhase() {
         ScreenRect rect;
         float nearest = 1.0f;
         // Object nodes by their own volume (a transformed box or k-DOP, tighter than the
-        // world box of a rotated part), scene nodes by their box.
-        const bool inFront = ref.isSceneNode() || !params_.useTightVolumes
-                                 ? projectRectDepth(box, rect, nearest)
-                                 : projectVolumeDepth(objectNodeVolume(objs, ref, params_.volume, params_.autoVolumeSaving),
-                                                      rect, nearest);
+        // world box of a rotated part), scene nodes by their box; both grown by rounding.
+        const bool inFront = projectVolumeDepth(
+            ref.isSceneNode() || !params_.useTightVolumes
+                ? QueryVolume::fromAabb(box)
+                : objectNodeVolume(objs, ref, params_.volume, params_.autoVolumeSaving),
+            rect, nearest);
         if (!inFront || box.contains(camera_.position)) {
             ++stats_->visibleNearOrInside;
             note(NodeState::VisibleNear);

@@ -174,6 +174,8 @@ private:
     void collectDrawAnswers();
     QueryVolume queryVolume(NodeRef ref, const Aabb& worldBox) const;
     bool projectRect(const Aabb& box, ScreenRect& out) const;
+    /// Normalised-device bounds [lo, hi] as viewport pixels, rounded outwards, padded by one.
+    ScreenRect pixelRect(const glm::dvec2& lo, const glm::dvec2& hi) const;
     void finishQuery(Pending& p, QueryResult r);
 
     void timedBeginBatch();
@@ -185,10 +187,9 @@ private:
     void runSimple();
     void runFull();
     void runTwoPhase();  // two_phase.cpp
-    /// The box's screen rectangle and its nearest window depth (reversed Z, the largest of
-    /// its corners'); false if it crosses the near plane (then it is simply visible).
-    bool projectRectDepth(const Aabb& box, ScreenRect& rect, float& nearestDepth) const;
-    /// The same for a query volume (grown by its vertices' rounding).
+    /// A query volume's screen rectangle and nearest window depth (reversed Z: the largest
+    /// of its points'), the volume grown by its vertices' rounding first; false if it
+    /// reaches the near plane (then it is simply visible).
     bool projectVolumeDepth(const QueryVolume& volume, ScreenRect& rect, float& nearestDepth) const;
 
     SchedulerParams params_;
