@@ -12,6 +12,7 @@
 #include "dyncull/engine/engine.hpp"
 #include "dyncull/engine/gl_context.hpp"
 #include "depth_convention.hpp"
+#include "face_culling.hpp"
 #include "shader_program.hpp"
 
 namespace dyncull {
@@ -149,9 +150,8 @@ VisibleSet GroundTruth::compute(const SceneObjects& objects, const Camera& camer
     glDepthMask(GL_TRUE);
     glDisable(GL_BLEND);
     // Faces as the renderer draws them: back faces culled per model (LocalBsp::faces).
-    glDisable(GL_CULL_FACE);
-    glCullFace(GL_BACK);
-    bool cullEnabled = false;
+    bool cullEnabled = false, frontCcw = true;
+    detail::resetFaceCulling(cullEnabled, frontCcw);
     detail::useReversedDepth();
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(detail::kDepthNearer);
@@ -166,12 +166,7 @@ VisibleSet GroundTruth::compute(const SceneObjects& objects, const Camera& camer
         const LocalBspNode& n = objects.model(model).nodes[ref.node];
         if (n.indexCount == 0) continue;
         const glm::mat4& toWorld = objects.matrix(ref.object);
-        const bool cull = models_[model].cullBack;
-        if (cull != cullEnabled) {
-            cull ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
-            cullEnabled = cull;
-        }
-        if (cull) glFrontFace(glm::determinant(glm::mat3(toWorld)) > 0.0f ? GL_CCW : GL_CW);  // mirrored objects
+        detail::setFaceCulling(cullEnabled, frontCcw, models_[model].cullBack, glm::mat3(toWorld));
         glUniform1ui(locId_, static_cast<GLuint>(i + 1));
         glUniformMatrix4fv(locModel_, 1, GL_FALSE, glm::value_ptr(camera.relativeModel(toWorld)));
         glBindVertexArray(models_[model].vao);
@@ -179,8 +174,7 @@ VisibleSet GroundTruth::compute(const SceneObjects& objects, const Camera& camer
                        reinterpret_cast<const void*>(static_cast<std::uintptr_t>(n.firstIndex) * sizeof(std::uint32_t)));
     }
     glBindVertexArray(0);
-    glDisable(GL_CULL_FACE);
-    glFrontFace(GL_CCW);
+    detail::resetFaceCulling(cullEnabled, frontCcw);
 
     const std::size_t rowPixels = static_cast<std::size_t>(width_);
     std::vector<std::uint32_t> bottomUp(rowPixels * static_cast<std::size_t>(height_));

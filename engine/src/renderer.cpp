@@ -11,6 +11,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "depth_convention.hpp"
+#include "face_culling.hpp"
 #include "shader_program.hpp"
 
 namespace dyncull {
@@ -115,11 +116,7 @@ void Renderer::beginFrame(const Camera& camera) {
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(detail::kDepthNearer);
     // Back faces are culled per mesh (GpuMesh::cullBack); drawRange switches the state.
-    glDisable(GL_CULL_FACE);
-    glCullFace(GL_BACK);
-    glFrontFace(GL_CCW);
-    cullEnabled_ = false;
-    frontCcw_ = true;
+    detail::resetFaceCulling(cullEnabled_, frontCcw_);
 
     viewProj_ = camera.viewProjection();
     // Camera-relative transforms: uViewProj has no translation and uModel carries the
@@ -153,17 +150,7 @@ void Renderer::drawRange(MeshId id, std::uint32_t firstIndex, std::uint32_t coun
     // draw on the CPU instead of per vertex.
     const glm::mat3 linear(model);
     const glm::mat3 normalMat = glm::inverseTranspose(linear);
-    const bool cull = g.cullBack && cullBackFaces_;
-    if (cull != cullEnabled_) {
-        cull ? glEnable(GL_CULL_FACE) : glDisable(GL_CULL_FACE);
-        cullEnabled_ = cull;
-    }
-    // A mirroring matrix (negative determinant) turns counter-clockwise triangles clockwise.
-    const bool ccw = glm::determinant(linear) > 0.0f;
-    if (cull && ccw != frontCcw_) {
-        glFrontFace(ccw ? GL_CCW : GL_CW);
-        frontCcw_ = ccw;
-    }
+    detail::setFaceCulling(cullEnabled_, frontCcw_, g.cullBack && cullBackFaces_, linear);
     const LitProgram& p = programs_[static_cast<int>(shading_)];
     glUseProgram(p.id);
     const glm::mat4 relative = camera_.relativeModel(model);
@@ -185,6 +172,7 @@ void Renderer::drawBoxDepthTestOnly(const Aabb& box, const glm::mat4& model) {
 }
 
 void Renderer::endFrame() {
+    detail::resetFaceCulling(cullEnabled_, frontCcw_);  // as beginFrame left it, whatever was drawn last
     glFlush();
     context_.checkErrors();
 }

@@ -66,6 +66,11 @@ TEST_F(RendererTest, CulledClosedCubeLooksTwoSidedFromOutsideEvenMirrored) {
         }
         EXPECT_FALSE(test::isClear(img[0].at(32, 32))) << "a mirrored cube lost its front faces";
         EXPECT_EQ(img[0].rgba, img[1].rgba);
+        // The frame leaves culling as it began it, whatever it drew last.
+        GLint front = 0;
+        glGetIntegerv(GL_FRONT_FACE, &front);
+        EXPECT_FALSE(glIsEnabled(GL_CULL_FACE));
+        EXPECT_EQ(front, GL_CCW);
     }
     // From inside, a closed surface shows only back faces: culled, nothing is drawn.
     Image inside[2];

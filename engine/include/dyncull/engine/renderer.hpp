@@ -78,7 +78,7 @@ public:
     /// Occlusion-query proxy: rasterises `box` (world space, or the space `model` maps to
     /// world) against depth with colour and depth writes off.
     void drawBoxDepthTestOnly(const Aabb& box, const glm::mat4& model = glm::mat4(1.0f));
-    /// Flushes and counts GL errors into the context.
+    /// Leaves face culling off (as beginFrame set it), flushes and counts GL errors into the context.
     void endFrame();
     /// Blocks until the GPU has finished all submitted work (for honest timings).
     void finish() const;
@@ -117,7 +117,7 @@ private:
     LitProgram programs_[2];  // indexed by Shading
     Shading shading_ = Shading::Vertex;
     bool cullBackFaces_ = true;
-    bool cullEnabled_ = false, frontCcw_ = true;  // GL state as drawRange last set it in this frame
+    bool cullEnabled_ = false, frontCcw_ = true;  // GL culling state as set in this frame (engine/src/face_culling.hpp)
     glm::mat4 viewProj_{1.0f};  // world space (box overlays); parts are drawn camera-relative
     Camera camera_;             // of the current frame, for camera-relative model matrices
     RenderStats stats_;
