@@ -65,6 +65,10 @@ float DepthPyramid::texel(int level, int x, int y) const {
 float DepthPyramid::farthestIn(const ScreenRect& rect) const {
     int x0, y0, x1, y1;
     if (levels_.empty() || !clampRect(rect, width_, height_, x0, y0, x1, y1)) return 1.0f;
+    return farthestInPixels(x0, y0, x1, y1);
+}
+
+float DepthPyramid::farthestInPixels(int x0, int y0, int x1, int y1) const {
     // The finest level where the rectangle spans at most kMaxSpan texels on both axes (at
     // the top level, 1x1, it always does); every texel it touches there is read.
     int k = 0;
@@ -82,7 +86,7 @@ float DepthPyramid::farthestIn(const ScreenRect& rect) const {
 bool DepthPyramid::occluded(const ScreenRect& rect, float nearestDepth) const {
     int x0, y0, x1, y1;
     if (levels_.empty() || !clampRect(rect, width_, height_, x0, y0, x1, y1)) return false;  // no evidence
-    const float farthest = farthestIn(rect);
+    const float farthest = farthestInPixels(x0, y0, x1, y1);
     // Reversed Z: behind means smaller. Equal or within the slack counts as visible.
     return nearestDepth < farthest - kDepthSlack * farthest;
 }

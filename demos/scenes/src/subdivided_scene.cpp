@@ -70,7 +70,7 @@ public:
             if (!builtinCameraScene(source_, options_)) walkthrough_ = staticModelWalkthrough(model->mesh);
             // The whole model's surface decides (one leaf alone is an open piece); shells
             // wound inwards were flipped before subdividing (subdivideStaticScene).
-            const SurfaceReport surface = analyseSurface(model->mesh);
+            const SurfaceReport surface = model->surface ? *model->surface : analyseSurface(model->mesh);
             leaves = subdivisionLeafModels(model->mesh, model->subdivision, surface.mode);
             surface_ = surface.summary();
             triangles = model->mesh.triangleCount();
@@ -164,7 +164,7 @@ Expected<SubdividedModel> subdivideStaticScene(const std::string& nameOrPath, co
     if (!soup) return soup.error();
     SubdividedModel m;
     m.mesh = std::move(soup->mesh);
-    orientSurface(m.mesh);  // before subdividing: the model file keeps the oriented triangles
+    m.surface = orientSurface(m.mesh);  // before subdividing: the model file keeps the oriented triangles
     m.source = soup->source;
     m.sourceHash = soup->sourceHash;
     m.params = *params;

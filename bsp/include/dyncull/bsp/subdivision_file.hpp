@@ -13,11 +13,13 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "dyncull/bsp/subdivision.hpp"
 #include "dyncull/objects/error.hpp"
 #include "dyncull/objects/mesh.hpp"
+#include "dyncull/objects/surface_orientation.hpp"
 
 namespace dyncull {
 
@@ -36,6 +38,9 @@ struct SubdividedModel {
     /// Generator parameter hash of a built-in source (0 for files): a run with other
     /// generator options would fly another camera path, so readers can refuse it.
     std::uint64_t sourceHash = 0;
+    /// The mesh's surface as orientSurface left it, when this process oriented it
+    /// (subdivideStaticScene); a model read from a file has none, and is analysed.
+    std::optional<SurfaceReport> surface;
 };
 
 /// Writes via a temporary file renamed into place (readers never see half a file).

@@ -59,6 +59,9 @@ public:
     static constexpr float kDepthSlack = 0x1p-16f;
 
 private:
+    /// farthestIn for inclusive pixel bounds already clamped to the screen.
+    float farthestInPixels(int x0, int y0, int x1, int y1) const;
+
     struct Level {
         std::size_t offset = 0;
         int width = 0, height = 0;
