@@ -21,8 +21,9 @@
 
 #include "dyncull/engine/gl_context.hpp"
 #include "dyncull/objects/convex_mesh.hpp"
-#include "depth_convention.hpp"
+#include "batched_raster_test.hpp"
 #include "shader_program.hpp"
+#include "volume_raster.hpp"
 
 namespace dyncull {
 namespace {
@@ -43,12 +44,18 @@ constexpr std::uint32_t kInitialIndices = 1024 * 3 * QueryVolume::kMaxTriangles;
 
 }  // namespace
 
+GlQueryBackend::GlQueryBackend(GlContext& context, GlQueryParams params) : context_(context), params_(params) {}
+
 Expected<std::unique_ptr<GlQueryBackend>> GlQueryBackend::create(GlContext& context, GlQueryParams params) {
     std::unique_ptr<GlQueryBackend> b(new GlQueryBackend(context, params));
     std::string log;
     b->program_ = detail::buildProgram(kVolumeVs, kVolumeFs, log);
     if (!b->program_) return Error{"query volume shader: " + log};
     b->locViewProj_ = glGetUniformLocation(b->program_, "uViewProj");
+    b->rasterState_ = std::make_unique<detail::VolumeTestState>();
+    auto batches = detail::BatchedRasterTest::create(context);
+    if (!batches) return Error{"query backend: " + batches.error().message};
+    b->batches_ = batches.take();
     // Boxes index a static 36-byte buffer; meshes stream their own indices. Two vertex
     // arrays over the same vertex stream, so the box path stays one upload and one draw.
     glCreateBuffers(1, &b->boxIbo_);
@@ -198,23 +205,7 @@ bool GlQueryBackend::readDepth(std::vector<float>& depth, int& width, int& heigh
 void GlQueryBackend::beginBatch() {
     assert(!inBatch_ && !inDrawQuery_);
     inBatch_ = true;
-    savedCull_ = glIsEnabled(GL_CULL_FACE);
-    savedDepthTest_ = glIsEnabled(GL_DEPTH_TEST);
-    glGetIntegerv(GL_DEPTH_FUNC, &savedDepthFunc_);
-    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-    glDepthMask(GL_FALSE);
-    glEnable(GL_DEPTH_TEST);
-    // Nearer-or-equal: a volume face coplanar with drawn geometry counts as visible (conservative).
-    glDepthFunc(detail::kDepthNearerOrEqual);
-    glDisable(GL_CULL_FACE);
-    // Pull volumes toward the eye by a few depth-buffer steps (scaled by GL to the face's
-    // depth slope and the buffer's resolution): a part lying on its box face, or a
-    // coplanar occluder, must not win a depth tie against the volume and hide a visible
-    // pixel. Reversed Z: toward the eye is a positive offset. With a float depth buffer one
-    // unit is 2^-23 of the face's own largest depth, so the pull stays a few ulps of
-    // distance at 1e-3 and at 1e6 alike.
-    glEnable(GL_POLYGON_OFFSET_FILL);
-    glPolygonOffset(detail::kTowardEye * 1.0f, detail::kTowardEye * 4.0f);
+    rasterState_->enter();
     glUseProgram(program_);
     glUniformMatrix4fv(locViewProj_, 1, GL_FALSE, glm::value_ptr(viewProj_));
     glBindVertexArray(boxVao_);
@@ -243,20 +234,11 @@ QueryId GlQueryBackend::issue(const QueryVolume& volume) {
     // Vertices relative to the eye, the volume enlarged to cover the float rounding its
     // world coordinates may carry, so a volume 1e7 units from the origin is never smaller
     // than the geometry it bounds and the query stays conservative.
-    std::array<glm::dvec3, QueryVolume::kMaxVertices> relD;
-    bool asBox = false;
-    const std::uint32_t points = volume.enlargedForRounding(eye_, relD, asBox);
-    std::array<glm::vec3, QueryVolume::kMaxVertices> rel;
-    for (std::uint32_t i = 0; i < points; ++i) rel[i] = glm::vec3(relD[i]);
-    const bool mesh = !asBox && !volume.isBox();
-    const std::uint32_t uploaded = points;
-    // The scheduler queries no box near the near plane (QueryScheduler::projectRect), but
-    // the enlargement may still carry a long volume across it: clipped there, it could
-    // answer "occluded" for visible geometry, so it answers Visible without being drawn.
-    for (std::uint32_t i = 0; i < uploaded; ++i) {
-        if (glm::dot(glm::dvec3(rel[i]), forward_) < nearPlane_) return answeredVisible();
-    }
-    glNamedBufferSubData(vbo_, vboUsed_ * sizeof(glm::vec3), uploaded * sizeof(glm::vec3), rel.data());
+    detail::DrawnVolume drawn;
+    if (!detail::prepareVolume(volume, {eye_, forward_, nearPlane_}, drawn)) return answeredVisible();
+    const bool mesh = drawn.mesh;
+    const std::uint32_t uploaded = drawn.count;
+    glNamedBufferSubData(vbo_, vboUsed_ * sizeof(glm::vec3), uploaded * sizeof(glm::vec3), drawn.points.data());
     if (mesh) glNamedBufferSubData(meshIbo_, iboUsed_, ni, volume.indices.data());
     if (boundMesh_ != mesh) {
         boundMesh_ = mesh;
@@ -282,12 +264,7 @@ QueryId GlQueryBackend::issue(const QueryVolume& volume) {
 void GlQueryBackend::endBatch() {
     assert(inBatch_);
     inBatch_ = false;
-    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    glDepthMask(GL_TRUE);
-    glDepthFunc(static_cast<GLenum>(savedDepthFunc_));
-    glDisable(GL_POLYGON_OFFSET_FILL);
-    if (savedCull_) glEnable(GL_CULL_FACE);
-    if (!savedDepthTest_) glDisable(GL_DEPTH_TEST);
+    rasterState_->leave();
     // Submit now so the rasteriser works on the queries while the CPU traverses on.
     if (params_.flushAfterBatch) glFlush();
 }
@@ -330,5 +307,35 @@ void GlQueryBackend::release(QueryId id) {
 }
 
 std::uint64_t GlQueryBackend::samples(QueryId id) const { return queries_[id].samples; }
+
+BatchId GlQueryBackend::testVolumes(std::span<const QueryVolume> volumes) {
+    assert(!inBatch_ && !inDrawQuery_);
+    // A query around the draw tells without blocking when the batch has been rasterised;
+    // its slot goes through the same safe-reuse queue as any query (see free_).
+    const QueryId q = startQuery();
+    glBeginQuery(queries_[q].target, queries_[q].name);
+    const BatchId id = batches_->draw(volumes, {eye_, forward_, nearPlane_}, viewProj_, *rasterState_);
+    glEndQuery(queries_[q].target);
+    if (params_.flushAfterBatch) glFlush();
+    if (batchQuery_.size() <= id) batchQuery_.resize(id + 1, kNoQuery);
+    batchQuery_[id] = q;
+    return id;
+}
+
+bool GlQueryBackend::collectVolumes(BatchId id, std::span<QueryResult> out, double waitMs) {
+    assert(id < batchQuery_.size() && batchQuery_[id] != kNoQuery);
+    const QueryId q = batchQuery_[id];
+    const QueryResult done = waitMs > 0 ? wait(q, waitMs) : poll(q);
+    if (done == QueryResult::NotReady && waitMs <= 0) return false;
+    if (done == QueryResult::NotReady) {
+        batches_->discard(id);  // timed out: never cull, never stall forever
+        std::fill(out.begin(), out.end(), QueryResult::Visible);
+    } else {
+        batches_->read(id, out);
+    }
+    release(q);
+    batchQuery_[id] = kNoQuery;
+    return true;
+}
 
 }  // namespace dyncull

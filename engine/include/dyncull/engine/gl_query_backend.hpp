@@ -17,6 +17,10 @@
 namespace dyncull {
 
 class GlContext;
+namespace detail {
+class VolumeTestState;
+class BatchedRasterTest;
+}  // namespace detail
 
 struct GlQueryParams {
     std::uint32_t visiblePixelThreshold = 0;  ///< 0 = conservative (any sample passes)
@@ -47,6 +51,10 @@ public:
     /// glReadPixels of the context framebuffer's depth (waits for the drawing so far);
     /// the read framebuffer binding and pack alignment are restored.
     bool readDepth(std::vector<float>& depth, int& width, int& height) override;
+    /// The batched raster test: one draw of all volumes into a visibility buffer, read
+    /// back once its fence has signalled (batched_raster_test.cpp).
+    BatchId testVolumes(std::span<const QueryVolume> volumes) override;
+    bool collectVolumes(BatchId id, std::span<QueryResult> out, double waitMs) override;
 
     const GlQueryParams& params() const { return params_; }
     void setParams(const GlQueryParams& p) { params_ = p; }
@@ -59,7 +67,7 @@ public:
     const Status& frameStatus() const { return frameStatus_; }
 
 private:
-    GlQueryBackend(GlContext& context, GlQueryParams params) : context_(context), params_(params) {}
+    GlQueryBackend(GlContext& context, GlQueryParams params);
     QueryResult fetch(QueryId id);
     QueryId acquireSlot();
     /// A free query object for the current threshold's target, marked live and unanswered.
@@ -104,9 +112,9 @@ private:
     glm::dvec3 eye_{0.0};            // world-space eye; volumes are uploaded relative to it
     glm::dvec3 forward_{0.0, 0.0, -1.0};  // unit view direction (world space)
     double nearPlane_ = 0.0;         // view distance of the near plane
-    // State saved by beginBatch, restored by endBatch.
-    int savedDepthFunc_ = 0;
-    bool savedCull_ = false, savedDepthTest_ = false;
+    std::unique_ptr<detail::VolumeTestState> rasterState_;  // entered by beginBatch, left by endBatch
+    std::unique_ptr<detail::BatchedRasterTest> batches_;    // testVolumes / collectVolumes
+    std::vector<QueryId> batchQuery_;  // per batch in flight: the query bracketing its draw
     bool inBatch_ = false;
     bool inDrawQuery_ = false;
     bool degraded_ = false;  // an allocation failed this frame: queries answer Visible

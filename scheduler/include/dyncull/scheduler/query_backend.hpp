@@ -64,6 +64,10 @@ using QueryId = std::uint32_t;
 /// Returned by a backend that cannot query a draw (QueryBackend::beginDrawQuery).
 inline constexpr QueryId kNoQuery = 0xffffffffu;
 
+using BatchId = std::uint32_t;
+/// Returned by a backend without the batched raster test (QueryBackend::testVolumes).
+inline constexpr BatchId kNoBatch = 0xffffffffu;
+
 class QueryBackend {
 public:
     virtual ~QueryBackend() = default;
@@ -103,6 +107,24 @@ public:
     /// then culls nothing by occlusion.
     virtual bool readDepth(std::vector<float>& depth, int& width, int& height) {
         (void)depth, (void)width, (void)height;
+        return false;
+    }
+    /// The batched raster test (NVIDIA's gl_occlusion_culling sample): every volume is
+    /// drawn in one pass against the depth drawn so far, and each fragment that passes
+    /// marks its volume visible. The answer rule is issue()'s (exact per pixel, enlarged
+    /// volumes, a volume reaching the near plane is Visible), but hundreds of volumes cost
+    /// one draw and one small readback. Outside a batch and a draw query. The volumes are
+    /// copied; kNoBatch if the backend cannot (the default).
+    virtual BatchId testVolumes(std::span<const QueryVolume> volumes) {
+        (void)volumes;
+        return kNoBatch;
+    }
+    /// Collects a batch into `out` (one entry per volume, in order: Visible or Occluded)
+    /// and releases it, returning true. With `waitMs` 0 it never blocks and returns false
+    /// while the answer is not ready; with `waitMs` > 0 it waits that long and then answers
+    /// every volume Visible (never cull, never stall forever). Every batch is collected once.
+    virtual bool collectVolumes(BatchId id, std::span<QueryResult> out, double waitMs) {
+        (void)id, (void)out, (void)waitMs;
         return false;
     }
 };
