@@ -49,7 +49,7 @@ ModeSpec fullMode(const std::string& name) {
 }  // namespace
 
 std::string modeNamesHelp() {
-    return "vfc, simple, full, twophase (draw last frame's visible parts, test the rest against their depth pyramid), oracle; approximate: thrN (pixel threshold), latency1 (last frame's results), "
+    return "vfc, simple, full, twophase (draw last frame's visible parts, test the rest against their depth pyramid, then what it cannot reject in one batched raster test), twophase-hzb (the pyramid alone), oracle; approximate: thrN (pixel threshold), latency1 (last frame's results), "
            "skipN (history max skip N, 2 per visible), overlap (overlapping batches), smallN (small-feature pixels); "
            "backend: noflush (no glFlush after each batch); "
            "conservative: frontN (front-most N% of leaves drawn without queries); "
@@ -160,8 +160,9 @@ Expected<ModeSpec> modeFromName(const std::string& name) {
         m.scheduler.mode = CullMode::Vfc;
     } else if (name == "simple") {
         m.scheduler.mode = CullMode::Simple;
-    } else if (name == "twophase") {
+    } else if (name == "twophase" || name == "twophase-hzb") {
         m.scheduler.mode = CullMode::TwoPhase;
+        m.scheduler.useBatchedRaster = name == "twophase";
     } else if (name == "oracle") {
         m.oracle = true;
     } else {

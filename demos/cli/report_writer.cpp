@@ -99,6 +99,8 @@ std::vector<ModeSummary> summarise(const BenchResult& r) {
             s.drawQueriesOccluded += f.stats.drawQueriesOccluded;
             s.depthTests += f.stats.depthTests;
             s.depthReadMs += f.stats.depthReadMs;
+            s.rasterTests += f.stats.rasterTests;
+            s.rasterMs += f.stats.rasterMs;
             s.largestRegion = std::max(s.largestRegion, f.image.largestRegion);
             s.timeouts += f.stats.queriesTimedOut;
         }
@@ -109,7 +111,7 @@ std::vector<ModeSummary> summarise(const BenchResult& r) {
         for (double* v : {&s.traversalMs, &s.queryMs, &s.waitMs, &s.drawMs, &s.parts, &s.triangles, &s.queries, &s.occluded,
                           &s.skippedHistory, &s.skippedOccupancy, &s.batches, &s.pctWrongMean, &s.falsePositives, &s.fpQueried,
                           &s.fpHistory, &s.fpOccupancy, &s.fpOther, &s.drawQueries, &s.drawQueriesOccluded, &s.depthTests,
-                          &s.depthReadMs})
+                          &s.depthReadMs, &s.rasterTests, &s.rasterMs})
             *v /= n;
         std::sort(ms.begin(), ms.end());
         s.msMin = ms.front();
@@ -175,7 +177,7 @@ Status writeFramesCsv(const BenchResult& r, const fs::path& path) {
          "pixels_wrong,pixels_wrong_pct,largest_wrong_region,frame_update_ms,ground_truth_ms,ground_truth_artefact_pixels,"
          "draw_queries,draw_queries_occluded,draw_queries_late,false_positives_queried,false_positives_history,"
          "false_positives_occupancy,false_positives_other,visible_triangles,bound_aabb_parts,bound_aabb_triangles,"
-         "bound_auto_parts,bound_auto_triangles,depth_tests,ms_depth_read\n";
+         "bound_auto_parts,bound_auto_triangles,depth_tests,ms_depth_read,raster_tests,raster_batches,ms_raster\n";
     for (std::size_t i = 0; i < r.frames.size(); ++i) {
         const FrameTruth& t = r.truth[i];
         for (std::size_t m = 0; m < r.modes.size(); ++m) {
@@ -198,7 +200,8 @@ Status writeFramesCsv(const BenchResult& r, const fs::path& path) {
                   << t.boundAuto.triangles;
             else
                 f << ",,,,";  // not measured
-            f << ',' << s.depthTests << ',' << s.depthReadMs << '\n';
+            f << ',' << s.depthTests << ',' << s.depthReadMs << ',' << s.rasterTests << ',' << s.rasterBatches << ','
+              << s.rasterMs << '\n';
         }
     }
     return closeChecked(f, path);
@@ -213,7 +216,7 @@ Status writeSummaryCsv(const std::vector<ModeSummary>& summary, const fs::path& 
          "largest_wrong_region,timeouts,pareto,volume,pct_parts_culled,query_triangles,leaf_volume,"
          "leaf_surface_area,leaf_triangles_mean,leaf_triangles_max,paired_vs_best,false_positives_queried,"
          "false_positives_history,false_positives_occupancy,false_positives_other,draw_queries,draw_queries_occluded,"
-         "depth_tests,ms_depth_read\n";
+         "depth_tests,ms_depth_read,raster_tests,ms_raster\n";
     for (const ModeSummary& s : summary)
         f << s.name << ',' << s.frames << ',' << s.msMean << ',' << s.msMedian << ',' << s.msMin << ',' << s.msMax
           << ',' << s.traversalMs << ',' << s.queryMs << ',' << s.waitMs << ',' << s.drawMs << ',' << s.ratioVfc << ',' << s.ratioOracle
@@ -225,7 +228,7 @@ Status writeSummaryCsv(const std::vector<ModeSummary>& summary, const fs::path& 
           << (s.leaves.leaves ? static_cast<double>(s.leaves.triangles) / static_cast<double>(s.leaves.leaves) : 0.0)
           << ',' << s.leaves.maxTriangles << ',' << s.pairedVsBest << ',' << s.fpQueried << ',' << s.fpHistory << ','
           << s.fpOccupancy << ',' << s.fpOther << ',' << s.drawQueries << ',' << s.drawQueriesOccluded << ','
-          << s.depthTests << ',' << s.depthReadMs << '\n';
+          << s.depthTests << ',' << s.depthReadMs << ',' << s.rasterTests << ',' << s.rasterMs << '\n';
     return closeChecked(f, path);
 }
 

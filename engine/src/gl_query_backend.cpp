@@ -53,6 +53,7 @@ Expected<std::unique_ptr<GlQueryBackend>> GlQueryBackend::create(GlContext& cont
     if (!b->program_) return Error{"query volume shader: " + log};
     b->locViewProj_ = glGetUniformLocation(b->program_, "uViewProj");
     b->rasterState_ = std::make_unique<detail::VolumeTestState>();
+    glGetIntegerv(GL_SUBPIXEL_BITS, &b->subpixelBits_);
     auto batches = detail::BatchedRasterTest::create(context);
     if (!batches) return Error{"query backend: " + batches.error().message};
     b->batches_ = batches.take();
@@ -98,12 +99,16 @@ GlQueryBackend::~GlQueryBackend() {
     if (program_) glDeleteProgram(program_);
 }
 
-void GlQueryBackend::beginFrame(const Camera& camera, int, int) {
+detail::VolumeView GlQueryBackend::volumeView() const { return {eye_, forward_, nearPlane_, growPerDistance_}; }
+
+void GlQueryBackend::beginFrame(const Camera& camera, int width, int height) {
     // Camera-relative like the renderer: volumes are uploaded relative to the eye.
     viewProj_ = camera.viewProjectionRelative();
     eye_ = glm::dvec3(camera.position);
     forward_ = glm::dvec3(camera.forward());
     nearPlane_ = double(camera.nearPlane);
+    growPerDistance_ = detail::snapGrowth(subpixelBits_, double(camera.fovYRadians), double(camera.aspect), std::max(width, 1),
+                                          std::max(height, 1));
     // Orphan last frame's volumes so writing this frame's never waits on the rasteriser.
     // After a failed allocation both buffers are allocated again (either may have no storage).
     const bool retry = degraded_;
@@ -235,7 +240,7 @@ QueryId GlQueryBackend::issue(const QueryVolume& volume) {
     // world coordinates may carry, so a volume 1e7 units from the origin is never smaller
     // than the geometry it bounds and the query stays conservative.
     detail::DrawnVolume drawn;
-    if (!detail::prepareVolume(volume, {eye_, forward_, nearPlane_}, drawn)) return answeredVisible();
+    if (!detail::prepareVolume(volume, volumeView(), drawn)) return answeredVisible();
     const bool mesh = drawn.mesh;
     const std::uint32_t uploaded = drawn.count;
     glNamedBufferSubData(vbo_, vboUsed_ * sizeof(glm::vec3), uploaded * sizeof(glm::vec3), drawn.points.data());
@@ -314,7 +319,7 @@ BatchId GlQueryBackend::testVolumes(std::span<const QueryVolume> volumes) {
     // its slot goes through the same safe-reuse queue as any query (see free_).
     const QueryId q = startQuery();
     glBeginQuery(queries_[q].target, queries_[q].name);
-    const BatchId id = batches_->draw(volumes, {eye_, forward_, nearPlane_}, viewProj_, *rasterState_);
+    const BatchId id = batches_->draw(volumes, volumeView(), viewProj_, *rasterState_);
     glEndQuery(queries_[q].target);
     if (params_.flushAfterBatch) glFlush();
     if (batchQuery_.size() <= id) batchQuery_.resize(id + 1, kNoQuery);

@@ -4,8 +4,11 @@
 //  2. their depth is read back into a farthest-depth pyramid (DepthPyramid);
 //  3. late pass: the tree is traversed front to back, every node tested against the
 //     pyramid (a rectangle and a depth, a few nanoseconds); an occluded node's subtree is
-//     skipped, a visible part not drawn in the early pass is drawn now; the outcome is
-//     next frame's early set.
+//     skipped;
+//  4. the parts the pyramid let through are tested exactly, per pixel, in one batched
+//     raster test against the early depth (NVIDIA's gl_occlusion_culling "temporal current
+//     frame" scheme) and the visible ones drawn; then every part drawn is tested against
+//     the final depth, and those visible there are next frame's early set.
 // Conservative: whatever is not drawn was hidden behind depth that the final image also
 // has (the early parts are drawn, and depth only grows nearer afterwards).
 #include <algorithm>
@@ -81,7 +84,12 @@ void QueryScheduler::runTwoPhase() {
     if (haveDepth) pyramid_.build(depth_, w, hgt);
     stats_->depthReadMs += msSince(t0);
 
-    // 3. Late pass.
+    // 3. Late pass. Parts the pyramid cannot reject are either drawn at once or, with the
+    // batched raster test, collected in `candidates_` and tested exactly afterwards; the
+    // parts drawn early are collected in `refresh_` to be tested against the final depth.
+    candidates_.clear();
+    refresh_.clear();
+    const bool raster = params_.useBatchedRaster;
     if (!(root == NodeRef{})) active_.push_back(root);
     while (!active_.empty()) {
         const NodeRef ref = active_.back();
@@ -105,14 +113,14 @@ void QueryScheduler::runTwoPhase() {
         float nearest = 1.0f;
         // Object nodes by their own volume (a transformed box or k-DOP, tighter than the
         // world box of a rotated part), scene nodes by their box; both grown by rounding.
-        const bool inFront = projectVolumeDepth(
-            ref.isSceneNode() || !params_.useTightVolumes
-                ? QueryVolume::fromAabb(box)
-                : objectNodeVolume(objs, ref, params_.volume, params_.autoVolumeSaving),
-            rect, nearest);
+        const QueryVolume volume = ref.isSceneNode() || !params_.useTightVolumes
+                                       ? QueryVolume::fromAabb(box)
+                                       : objectNodeVolume(objs, ref, params_.volume, params_.autoVolumeSaving);
+        const bool inFront = projectVolumeDepth(volume, rect, nearest);
+        bool certain = false;  // visible without any test (near plane, camera inside)
         if (!inFront || box.contains(camera_.position)) {
             ++stats_->visibleNearOrInside;
-            note(NodeState::VisibleNear);
+            certain = true;
         } else if (rect.empty()) {
             ++stats_->frustumCulled;
             h.lastVisible = false;
@@ -126,18 +134,63 @@ void QueryScheduler::runTwoPhase() {
                 note(NodeState::Occluded);
                 continue;
             }
-            note(NodeState::VisibleQueried);
         }
         h.lastVisible = true;
         h.lastVisibleFrame = frame_;
-        if (tree_->isDrawable(ref)) {
-            if (!drawnEarly) drawNode(ref, false);
-            continue;
+        if (!tree_->isDrawable(ref)) {
+            note(certain ? NodeState::VisibleNear : NodeState::VisibleQueried);
+            scratch_.clear();
+            tree_->expand(ref, camera_.position, scratch_);
+            for (auto it = scratch_.rbegin(); it != scratch_.rend(); ++it) active_.push_back(*it);
+        } else if (drawnEarly) {
+            if (raster && !certain) refresh_.push_back({ref, volume});
+        } else if (raster && !certain) {
+            candidates_.push_back({ref, volume});
+        } else {
+            note(certain ? NodeState::VisibleNear : NodeState::VisibleQueried);
+            drawNode(ref, false);
         }
-        scratch_.clear();
-        tree_->expand(ref, camera_.position, scratch_);
-        for (auto it = scratch_.rbegin(); it != scratch_.rend(); ++it) active_.push_back(*it);
     }
+
+    // 4. The batched raster test, exact per pixel against the early pass's depth, for the
+    // parts the pyramid let through; then every part drawn after a test (early, or late
+    // after this one) against the final depth: one hidden there is not drawn early next
+    // frame (the first frame, which has no early set, would otherwise draw everything twice).
+    if (!candidates_.empty()) {
+        rasterTest(candidates_);
+        for (std::size_t i = 0; i < candidates_.size(); ++i) {
+            const NodeRef ref = candidates_[i].ref;
+            NodeHistory& h = history_.at(ref, objs);
+            if (rasterAnswers_[i] == QueryResult::Occluded) {
+                ++stats_->queriesOccluded;
+                h.lastVisible = false;
+                trace(ref, tree_->worldBox(ref), NodeState::Occluded);
+            } else {
+                trace(ref, tree_->worldBox(ref), NodeState::VisibleQueried);
+                drawNode(ref, false);
+                refresh_.push_back(candidates_[i]);  // may be hidden by parts drawn after it
+            }
+        }
+    }
+    if (!refresh_.empty()) {
+        rasterTest(refresh_);
+        for (std::size_t i = 0; i < refresh_.size(); ++i)
+            if (rasterAnswers_[i] == QueryResult::Occluded) history_.at(refresh_[i].ref, objs).lastVisible = false;
+    }
+}
+
+void QueryScheduler::rasterTest(const std::vector<TestedPart>& parts) {
+    const auto t0 = Clock::now();
+    rasterVolumes_.clear();
+    for (const TestedPart& p : parts) rasterVolumes_.push_back(p.volume);
+    rasterAnswers_.assign(parts.size(), QueryResult::Visible);
+    const BatchId batch = backend_->testVolumes(rasterVolumes_);
+    if (batch != kNoBatch) {
+        backend_->collectVolumes(batch, rasterAnswers_, params_.queryTimeoutMs);  // nothing else to do meanwhile
+        ++stats_->rasterBatches;
+        stats_->rasterTests += static_cast<std::uint32_t>(parts.size());
+    }
+    stats_->rasterMs += msSince(t0);
 }
 
 }  // namespace dyncull

@@ -94,7 +94,7 @@ protected:
 TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
     ASSERT_NO_FATAL_FAILURE(build("dyncull_conservative_", 30));
 
-    const char* conservative = "vfc,simple,full,full-nohist,full-nobatch,full-noocc,full-notight,full-nodrawq,order,front10,twophase,oracle,thr64";
+    const char* conservative = "vfc,simple,full,full-nohist,full-nobatch,full-noocc,full-notight,full-nodrawq,order,front10,twophase,twophase-hzb,oracle,thr64";
     auto modes = cli::modesFromList(conservative);
     ASSERT_TRUE(modes.ok()) << modes.error().message;
     // The test checks culling, not latency: a query that outlasts the default 250 ms bound
@@ -108,6 +108,7 @@ TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
     ASSERT_EQ(names[0].name, "vfc");
 
     std::uint64_t visibleSeen = 0, thresholdMisses = 0, occludedSeen = 0, queries = 0, drawQueriesOccluded = 0, boundSlack = 0;
+    std::uint64_t rasterTests = 0, rasterParts = 0, pyramidParts = 0;  // twophase with and without the batched raster test
     double worstPercent = 0.0;
     for (std::uint64_t frame = 0; frame < bo.frames; ++frame) {
         ASSERT_TRUE((*runner)->runFrame(frame).ok());
@@ -136,6 +137,11 @@ TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
             worstPercent = std::max(worstPercent, row[m].image.percentDiffering);
             queries += row[m].stats.queriesIssued;
             if (names[m].name == "full") drawQueriesOccluded += row[m].stats.drawQueriesOccluded;
+            if (names[m].name == "twophase") rasterTests += row[m].stats.rasterTests, rasterParts += row[m].stats.partsDrawn;
+            if (names[m].name == "twophase-hzb") {
+                pyramidParts += row[m].stats.partsDrawn;
+                EXPECT_EQ(row[m].stats.rasterTests, 0u);
+            }
             // Every false positive has exactly one cause.
             const cli::FalsePositiveCauses& c = row[m].falsePositiveCauses;
             EXPECT_EQ(c.queried + c.history + c.occupancy + c.other, row[m].parts.falsePositives);
@@ -154,6 +160,9 @@ TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
     // Real GL draw queries answered, and some parts drawn untested turned out hidden.
     EXPECT_GT(drawQueriesOccluded, 0u);
     EXPECT_GT(boundSlack, 0u) << "some hidden part should have a visible box";
+    // The batched raster test ran, and culled parts the pyramid alone let through.
+    EXPECT_GT(rasterTests, 0u);
+    EXPECT_LT(rasterParts, pyramidParts);
     EXPECT_EQ(ctx->checkErrors(), 0u);
 }
 

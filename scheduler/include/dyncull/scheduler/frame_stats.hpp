@@ -15,6 +15,9 @@ struct FrameStats {
     std::uint32_t queriesIssued = 0;
     std::uint32_t depthTests = 0;    ///< two-phase: nodes tested against the depth pyramid
     double depthReadMs = 0.0;        ///< two-phase: reading the depth back (waits for the early pass) and building the pyramid
+    std::uint32_t rasterTests = 0;    ///< two-phase: volumes in batched raster tests (QueryBackend::testVolumes)
+    std::uint32_t rasterBatches = 0;  ///< two-phase: batched raster tests issued
+    double rasterMs = 0.0;            ///< two-phase: building, drawing and waiting for the batched raster tests
     std::uint64_t queryTriangles = 0;   ///< triangles of the query volumes drawn (12 per box)
     std::uint32_t queriesOccluded = 0;  ///< answered "occluded"
     std::uint32_t queriesTimedOut = 0;  ///< never answered within the bound; counted visible

@@ -97,6 +97,13 @@ struct SchedulerParams {
     /// Issue queries even when their rectangles overlap pending ones (more answers
     /// "visible" than needed; measured, conservative in itself).
     bool batchOverlapping = false;
+
+    /// TwoPhase: a part the depth pyramid cannot reject goes to the backend's batched
+    /// raster test (QueryBackend::testVolumes), exact per pixel, before it is drawn; and
+    /// the parts drawn early are tested again against the frame's final depth, so a part
+    /// that turned hidden is not drawn early next frame. Off: such parts are drawn (the
+    /// pyramid alone, an ablation).
+    bool useBatchedRaster = true;
 };
 
 /// What the scheduler decided for a node reached during a frame (for the node-box view
@@ -215,9 +222,20 @@ private:
     std::vector<NodeTrace>* trace_ = nullptr;
     // useLastFrameResults: queries issued in an earlier frame, read when they answer.
     std::vector<Pending> latent_;
-    // TwoPhase: the early pass's depth and its pyramid, reused across frames.
+    // TwoPhase: the early pass's depth and its pyramid, reused across frames; the parts
+    // for the batched raster test and its answers.
     std::vector<float> depth_;
     DepthPyramid pyramid_;
+    struct TestedPart {
+        NodeRef ref;
+        QueryVolume volume;  // world space, as the pyramid tested it
+    };
+    std::vector<TestedPart> candidates_, refresh_;
+    std::vector<QueryVolume> rasterVolumes_;
+    std::vector<QueryResult> rasterAnswers_;
+    /// One batched raster test of `parts`' volumes, answers in rasterAnswers_ (all Visible
+    /// if the backend has no such test), waiting for them: nothing else is left to do.
+    void rasterTest(const std::vector<TestedPart>& parts);
     // useDrawQueries: this frame's draw queries, and last frame's not yet read.
     std::vector<Pending> drawQueries_, drawAnswers_;
 
