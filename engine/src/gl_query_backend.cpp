@@ -53,7 +53,6 @@ Expected<std::unique_ptr<GlQueryBackend>> GlQueryBackend::create(GlContext& cont
     if (!b->program_) return Error{"query volume shader: " + log};
     b->locViewProj_ = glGetUniformLocation(b->program_, "uViewProj");
     b->rasterState_ = std::make_unique<detail::VolumeTestState>();
-    glGetIntegerv(GL_SUBPIXEL_BITS, &b->subpixelBits_);
     auto batches = detail::BatchedRasterTest::create(context);
     if (!batches) return Error{"query backend: " + batches.error().message};
     b->batches_ = batches.take();
@@ -99,16 +98,14 @@ GlQueryBackend::~GlQueryBackend() {
     if (program_) glDeleteProgram(program_);
 }
 
-detail::VolumeView GlQueryBackend::volumeView() const { return {eye_, forward_, nearPlane_, growPerDistance_}; }
+detail::VolumeView GlQueryBackend::volumeView() const { return {eye_, forward_, nearPlane_}; }
 
-void GlQueryBackend::beginFrame(const Camera& camera, int width, int height) {
+void GlQueryBackend::beginFrame(const Camera& camera, int, int) {
     // Camera-relative like the renderer: volumes are uploaded relative to the eye.
     viewProj_ = camera.viewProjectionRelative();
     eye_ = glm::dvec3(camera.position);
     forward_ = glm::dvec3(camera.forward());
     nearPlane_ = double(camera.nearPlane);
-    growPerDistance_ = detail::snapGrowth(subpixelBits_, double(camera.fovYRadians), double(camera.aspect), std::max(width, 1),
-                                          std::max(height, 1));
     // Orphan last frame's volumes so writing this frame's never waits on the rasteriser.
     // After a failed allocation both buffers are allocated again (either may have no storage).
     const bool retry = degraded_;

@@ -46,19 +46,16 @@ QueryVolume QueryVolume::fromNodeVolume(const glm::mat4& objectToWorld, const No
 }
 
 std::uint32_t QueryVolume::enlargedForRounding(const glm::dvec3& eye, std::array<glm::dvec3, kMaxVertices>& out,
-                                               bool& asBox, double growPerDistance) const {
+                                               bool& asBox) const {
     const std::uint32_t nv = vertexCount;
     glm::dvec3 centre(0.0);
-    double magnitude = 0.0, farthest = 0.0;
+    double magnitude = 0.0;
     for (std::uint32_t i = 0; i < nv; ++i) {
         const glm::dvec3 v(vertices[i]);
         centre += v / double(nv);
         magnitude = std::max({magnitude, std::abs(v.x), std::abs(v.y), std::abs(v.z)});
-        farthest = std::max(farthest, glm::length(v - eye));
     }
-    // The rasteriser's share is taken at twice the farthest vertex's distance: a pixel's
-    // width grows with distance, and the grown volume reaches a little farther.
-    const double slack = magnitude * 0x1p-22, push = slack * std::sqrt(3.0) + growPerDistance * 2.0 * farthest;
+    const double slack = magnitude * 0x1p-22, push = slack * std::sqrt(3.0);
     // Scaling about the centre moves every face out by (k - 1) times its distance from the
     // centre and keeps its normal, so k = 1 + push / (nearest face distance) moves each
     // face out by at least `push` (a per-axis push would slide tilted faces along themselves).

@@ -113,8 +113,6 @@ private:
     glm::dvec3 eye_{0.0};            // world-space eye; volumes are uploaded relative to it
     glm::dvec3 forward_{0.0, 0.0, -1.0};  // unit view direction (world space)
     double nearPlane_ = 0.0;         // view distance of the near plane
-    double growPerDistance_ = 0.0;   // volumes grown for vertex snapping (detail::snapGrowth)
-    int subpixelBits_ = 4;           // GL_SUBPIXEL_BITS (4 is GL's minimum)
     detail::VolumeView volumeView() const;
     std::unique_ptr<detail::VolumeTestState> rasterState_;  // entered by beginBatch, left by endBatch
     std::unique_ptr<detail::BatchedRasterTest> batches_;    // testVolumes / collectVolumes

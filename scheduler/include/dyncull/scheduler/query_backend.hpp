@@ -56,13 +56,8 @@ struct QueryVolume {
     /// or, thinner than a few roundings, the 8 corners of its vertices' box, each face
     /// pushed out along its axis (`asBox` is then set). Returns the number of points
     /// written. What a backend draws and a CPU test projects, so neither is ever smaller
-    /// than the geometry the volume bounds, at 1e7 from the origin too. With
-    /// `growPerDistance` > 0 every face also moves out by that many world units per unit of
-    /// distance from the eye (taken generously at the volume's far end): a backend passes
-    /// the rasteriser's subpixel snapping, so that a part whose snapped edge covers a pixel
-    /// centre just outside its exact outline still lies inside its snapped volume.
-    std::uint32_t enlargedForRounding(const glm::dvec3& eye, std::array<glm::dvec3, kMaxVertices>& out, bool& asBox,
-                                      double growPerDistance = 0.0) const;
+    /// than the geometry the volume bounds, at 1e7 from the origin too.
+    std::uint32_t enlargedForRounding(const glm::dvec3& eye, std::array<glm::dvec3, kMaxVertices>& out, bool& asBox) const;
 };
 
 using QueryId = std::uint32_t;
