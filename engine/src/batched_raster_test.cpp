@@ -15,7 +15,6 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "dyncull/engine/gl_context.hpp"
-#include "dyncull/objects/convex_mesh.hpp"
 #include "shader_program.hpp"
 
 namespace dyncull::detail {
@@ -92,7 +91,7 @@ BatchId BatchedRasterTest::draw(std::span<const QueryVolume> volumes, const Volu
     b.count = static_cast<std::uint32_t>(volumes.size());
     b.visibleUndrawn.assign(volumes.size(), 0);
 
-    // Streams: each volume's points with its index, boxes through the 36 box indices.
+    // Streams: each volume's points with its index, and its triangles.
     vertices_.clear();
     indices_.clear();
     DrawnVolume drawn;
@@ -103,8 +102,7 @@ BatchId BatchedRasterTest::draw(std::span<const QueryVolume> volumes, const Volu
         }
         const auto base = static_cast<std::uint32_t>(vertices_.size());
         for (std::uint32_t k = 0; k < drawn.count; ++k) vertices_.push_back({drawn.points[k], i});
-        const std::span<const std::uint8_t> tris = drawn.mesh ? volumes[i].triangles() : std::span<const std::uint8_t>(kBoxTriangles);
-        for (std::uint8_t k : tris) indices_.push_back(base + k);
+        for (std::uint32_t k = 0; k < drawn.indexCount; ++k) indices_.push_back(base + drawn.indices[k]);
     }
 
     if (b.capacity < b.count) {

@@ -20,7 +20,6 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "dyncull/engine/gl_context.hpp"
-#include "dyncull/objects/convex_mesh.hpp"
 #include "batched_raster_test.hpp"
 #include "shader_program.hpp"
 #include "volume_raster.hpp"
@@ -37,10 +36,10 @@ const char* const kVolumeFs = R"(#version 450 core
 void main() {}
 )";
 
-// Streaming capacity at start (grows by doubling): vertices for 4096 boxes, and 8-bit
-// indices for 1024 k-DOPs of up to 92 triangles.
-constexpr std::uint32_t kInitialVertices = 4096 * 8;
-constexpr std::uint32_t kInitialIndices = 1024 * 3 * QueryVolume::kMaxTriangles;
+// Streaming capacity at start (grows by doubling): 4096 boxes with their snapping rings
+// (8 + 4 x 6 points, 3 x (12 + 2 x 6) indices).
+constexpr std::uint32_t kInitialVertices = 4096 * 32;
+constexpr std::uint32_t kInitialIndices = 4096 * 72;
 
 }  // namespace
 
@@ -56,32 +55,26 @@ Expected<std::unique_ptr<GlQueryBackend>> GlQueryBackend::create(GlContext& cont
     auto batches = detail::BatchedRasterTest::create(context);
     if (!batches) return Error{"query backend: " + batches.error().message};
     b->batches_ = batches.take();
-    // Boxes index a static 36-byte buffer; meshes stream their own indices. Two vertex
-    // arrays over the same vertex stream, so the box path stays one upload and one draw.
-    glCreateBuffers(1, &b->boxIbo_);
-    glNamedBufferStorage(b->boxIbo_, sizeof(kBoxTriangles), kBoxTriangles.data(), 0);
-    if (Status st = context.checkAllocation("creating the query box index buffer", sizeof(kBoxTriangles)); !st)
-        return Error{"query backend: " + st.message()};
-    glCreateBuffers(1, &b->meshIbo_);
+    b->view_ = std::make_unique<detail::VolumeView>();
+    glGetIntegerv(GL_SUBPIXEL_BITS, &b->subpixelBits_);
+    // Every volume streams its points and 8-bit indices (its triangles and its snapping ring).
+    glCreateBuffers(1, &b->ibo_);
     glCreateBuffers(1, &b->vbo_);
     b->iboCapacity_ = kInitialIndices;
     b->vboCapacity_ = kInitialVertices;
     // On failure the destructor deletes what was created.
-    glNamedBufferData(b->meshIbo_, b->iboCapacity_, nullptr, GL_STREAM_DRAW);
+    glNamedBufferData(b->ibo_, b->iboCapacity_, nullptr, GL_STREAM_DRAW);
     if (Status st = context.checkAllocation("creating the query volume index buffer", b->iboCapacity_); !st)
         return Error{"query backend: " + st.message()};
     glNamedBufferData(b->vbo_, b->vboCapacity_ * sizeof(glm::vec3), nullptr, GL_STREAM_DRAW);
     if (Status st = context.checkAllocation("creating the query volume vertex buffer", b->vboCapacity_ * sizeof(glm::vec3)); !st)
         return Error{"query backend: " + st.message()};
-    glCreateVertexArrays(1, &b->boxVao_);
-    glCreateVertexArrays(1, &b->meshVao_);
-    for (std::uint32_t vao : {b->boxVao_, b->meshVao_}) {
-        glVertexArrayVertexBuffer(vao, 0, b->vbo_, 0, sizeof(glm::vec3));
-        glVertexArrayElementBuffer(vao, vao == b->boxVao_ ? b->boxIbo_ : b->meshIbo_);
-        glEnableVertexArrayAttrib(vao, 0);
-        glVertexArrayAttribFormat(vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
-        glVertexArrayAttribBinding(vao, 0, 0);
-    }
+    glCreateVertexArrays(1, &b->vao_);
+    glVertexArrayVertexBuffer(b->vao_, 0, b->vbo_, 0, sizeof(glm::vec3));
+    glVertexArrayElementBuffer(b->vao_, b->ibo_);
+    glEnableVertexArrayAttrib(b->vao_, 0);
+    glVertexArrayAttribFormat(b->vao_, 0, 3, GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribBinding(b->vao_, 0, 0);
     return b;
 }
 
@@ -90,22 +83,24 @@ GlQueryBackend::~GlQueryBackend() {
     // (see free_ in the header).
     glFinish();
     for (Slot& s : queries_) glDeleteQueries(1, &s.name);
-    glDeleteVertexArrays(1, &boxVao_);
-    glDeleteVertexArrays(1, &meshVao_);
+    glDeleteVertexArrays(1, &vao_);
     glDeleteBuffers(1, &vbo_);
-    glDeleteBuffers(1, &boxIbo_);
-    glDeleteBuffers(1, &meshIbo_);
+    glDeleteBuffers(1, &ibo_);
     if (program_) glDeleteProgram(program_);
 }
 
-detail::VolumeView GlQueryBackend::volumeView() const { return {eye_, forward_, nearPlane_}; }
-
-void GlQueryBackend::beginFrame(const Camera& camera, int, int) {
+void GlQueryBackend::beginFrame(const Camera& camera, int width, int height) {
     // Camera-relative like the renderer: volumes are uploaded relative to the eye.
     viewProj_ = camera.viewProjectionRelative();
-    eye_ = glm::dvec3(camera.position);
-    forward_ = glm::dvec3(camera.forward());
-    nearPlane_ = double(camera.nearPlane);
+    detail::VolumeView& v = *view_;
+    v.eye = glm::dvec3(camera.position);
+    v.forward = glm::dvec3(camera.forward());
+    v.nearPlane = double(camera.nearPlane);
+    v.viewProj = camera.viewProjectionRelativeDouble();
+    v.inverseViewProj = glm::inverse(v.viewProj);
+    v.width = std::max(width, 1);
+    v.height = std::max(height, 1);
+    v.ringPixels = params_.snappingRing ? detail::ringWidth(subpixelBits_) : 0.0;
     // Orphan last frame's volumes so writing this frame's never waits on the rasteriser.
     // After a failed allocation both buffers are allocated again (either may have no storage).
     const bool retry = degraded_;
@@ -114,7 +109,7 @@ void GlQueryBackend::beginFrame(const Camera& camera, int, int) {
     vboUsed_ = 0;
     if (allocate(vbo_, vboCapacity_ * sizeof(glm::vec3), "orphaning the query volume vertex buffer") &&
         (iboUsed_ > 0 || retry))
-        allocate(meshIbo_, iboCapacity_, "orphaning the query volume index buffer");
+        allocate(ibo_, iboCapacity_, "orphaning the query volume index buffer");
     iboUsed_ = 0;
 }
 
@@ -210,56 +205,43 @@ void GlQueryBackend::beginBatch() {
     rasterState_->enter();
     glUseProgram(program_);
     glUniformMatrix4fv(locViewProj_, 1, GL_FALSE, glm::value_ptr(viewProj_));
-    glBindVertexArray(boxVao_);
-    boundMesh_ = false;
+    glBindVertexArray(vao_);
 }
 
 QueryId GlQueryBackend::issue(const QueryVolume& volume) {
     assert(inBatch_);
     assert(volume.vertexCount <= QueryVolume::kMaxVertices && volume.triangleCount <= QueryVolume::kMaxTriangles);
     assert(!volume.isBox() || volume.vertexCount == 8);
-    const std::uint32_t nv = volume.vertexCount, ni = 3 * volume.triangleCount;
-    const std::uint32_t reserve = std::max(nv, 8u);  // a thin volume is drawn as an 8-corner box
+    // Vertices relative to the eye, the volume enlarged to cover the float rounding its
+    // world coordinates may carry, so a volume 1e7 units from the origin is never smaller
+    // than the geometry it bounds and the query stays conservative.
+    detail::DrawnVolume drawn;
+    if (!detail::prepareVolume(volume, *view_, drawn)) return answeredVisible();
+    const std::uint32_t nv = drawn.count, ni = drawn.indexCount;
     // Grow by doubling: earlier draws of this frame keep the orphaned storage they
     // referenced. On failure the capacity stays at the last size that worked.
-    if (!degraded_ && vboUsed_ + reserve > vboCapacity_ &&
+    if (!degraded_ && vboUsed_ + nv > vboCapacity_ &&
         allocate(vbo_, std::size_t{2} * vboCapacity_ * sizeof(glm::vec3), "growing the query volume vertex buffer")) {
         vboCapacity_ *= 2;
         vboUsed_ = 0;
     }
     if (!degraded_ && iboUsed_ + ni > iboCapacity_ &&
-        allocate(meshIbo_, std::size_t{2} * iboCapacity_, "growing the query volume index buffer")) {
+        allocate(ibo_, std::size_t{2} * iboCapacity_, "growing the query volume index buffer")) {
         iboCapacity_ *= 2;
         iboUsed_ = 0;
     }
     if (degraded_) return answeredVisible();  // no buffer to draw the volume from: never culls, never waits
-    // Vertices relative to the eye, the volume enlarged to cover the float rounding its
-    // world coordinates may carry, so a volume 1e7 units from the origin is never smaller
-    // than the geometry it bounds and the query stays conservative.
-    detail::DrawnVolume drawn;
-    if (!detail::prepareVolume(volume, volumeView(), drawn)) return answeredVisible();
-    const bool mesh = drawn.mesh;
-    const std::uint32_t uploaded = drawn.count;
-    glNamedBufferSubData(vbo_, vboUsed_ * sizeof(glm::vec3), uploaded * sizeof(glm::vec3), drawn.points.data());
-    if (mesh) glNamedBufferSubData(meshIbo_, iboUsed_, ni, volume.indices.data());
-    if (boundMesh_ != mesh) {
-        boundMesh_ = mesh;
-        glBindVertexArray(boundMesh_ ? meshVao_ : boxVao_);
-    }
+    glNamedBufferSubData(vbo_, vboUsed_ * sizeof(glm::vec3), nv * sizeof(glm::vec3), drawn.points.data());
+    glNamedBufferSubData(ibo_, iboUsed_, ni, drawn.indices.data());
 
     const QueryId id = startQuery();
     const std::uint32_t target = queries_[id].target;
     glBeginQuery(target, queries_[id].name);
-    if (!mesh) {
-        glDrawElementsBaseVertex(GL_TRIANGLES, 36, GL_UNSIGNED_BYTE, nullptr, static_cast<GLint>(vboUsed_));
-    } else {
-        glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(ni), GL_UNSIGNED_BYTE,
-                                 reinterpret_cast<const void*>(static_cast<std::uintptr_t>(iboUsed_)),
-                                 static_cast<GLint>(vboUsed_));
-        iboUsed_ += ni;
-    }
+    glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(ni), GL_UNSIGNED_BYTE,
+                             reinterpret_cast<const void*>(static_cast<std::uintptr_t>(iboUsed_)), static_cast<GLint>(vboUsed_));
     glEndQuery(target);
-    vboUsed_ += uploaded;
+    iboUsed_ += ni;
+    vboUsed_ += nv;
     return id;
 }
 
@@ -316,7 +298,7 @@ BatchId GlQueryBackend::testVolumes(std::span<const QueryVolume> volumes) {
     // its slot goes through the same safe-reuse queue as any query (see free_).
     const QueryId q = startQuery();
     glBeginQuery(queries_[q].target, queries_[q].name);
-    const BatchId id = batches_->draw(volumes, volumeView(), viewProj_, *rasterState_);
+    const BatchId id = batches_->draw(volumes, *view_, viewProj_, *rasterState_);
     glEndQuery(queries_[q].target);
     if (params_.flushAfterBatch) glFlush();
     if (batchQuery_.size() <= id) batchQuery_.resize(id + 1, kNoQuery);

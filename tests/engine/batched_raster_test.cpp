@@ -1,6 +1,8 @@
 // The batched raster test (GlQueryBackend::testVolumes) against its oracle, one hardware
 // query per volume: the same answer for every volume of a random scene, volumes reaching
 // the near plane answered Visible undrawn, and the GL state left as it was found.
+#include <cmath>
+#include <cstdio>
 #include <random>
 #include <vector>
 
@@ -157,6 +159,112 @@ TEST(BatchedRasterTest, NearPlaneVolumesAreVisibleUndrawnAndStateIsRestored) {
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glDeleteBuffers(1, &ssbo);
     r.endFrame();
+    EXPECT_EQ(ctx->checkErrors(), 0u);
+}
+
+/// Pixels (x, y from the bottom) a drawn part covers: not the clear colour.
+std::vector<glm::ivec2> coveredPixels(Renderer& r, int w, int h) {
+    const Image img = r.readPixels();
+    std::vector<glm::ivec2> out;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            if (!test::isClear(img.at(x, h - 1 - y))) out.push_back({x, y});
+    return out;
+}
+
+// The rasteriser snaps window coordinates to 1/256 pixel (llvmpipe), so a part's slanted
+// edge can cover a pixel centre just outside its exact outline, and the edge of a tight
+// volume through the same line, snapped on its own, can miss it. Each random triangle gets
+// a box with one face through its edge AB; each of its pixels alone is left uncovered by a
+// nearer depth, and a hardware query of the box must see it. Without the snapping ring
+// some pixels are missed (the test shows the case exists); with it none is.
+TEST(VolumeSnapping, TheRingKeepsEveryPixelOfAPartInsideItsVolume) {
+    constexpr int kSize = 64;
+    auto ctx = test::headless(kSize, kSize);
+    ASSERT_TRUE(ctx);
+    auto made = Renderer::create(*ctx);
+    ASSERT_TRUE(made.ok()) << made.error().message;
+    Renderer& r = **made;
+    const Camera cam = test::cameraOnZ(3.0f);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> coord(-0.9f, 0.9f), angle(0.0f, 6.2832f), len(0.3f, 0.9f), height(0.05f, 0.3f);
+    std::uint32_t missedWithout = 0, missedWith = 0, pixels = 0;
+    for (bool ring : {false, true}) {
+        GlQueryParams qp;
+        qp.snappingRing = ring;
+        auto backendOr = GlQueryBackend::create(*ctx, qp);
+        ASSERT_TRUE(backendOr.ok()) << backendOr.error().message;
+        GlQueryBackend& b = **backendOr;
+        rng.seed(7);
+        for (int trial = 0; trial < 1500; ++trial) {
+            // Triangle A, B, C in the plane z = 0, and the box spanned by AB and C.
+            // Line AB passes through the view axis, so the box's depth does not move its outline
+            // on screen there, and the box is thick enough that its rounding growth is far below
+            // a snapping step: the box's outline lies on the line AB to within 1e-4 pixel.
+            const float phi = angle(rng);
+            const glm::vec3 u(std::cos(phi), std::sin(phi), 0.0f), v(-u.y, u.x, 0.0f);
+            const glm::vec3 a = (coord(rng) - 0.45f) * u;
+            const glm::vec3 bv = a + len(rng) * u, c = a + 0.5f * len(rng) * u + height(rng) * v;
+            Mesh tri;
+            tri.name = "triangle";
+            tri.positions = {a, bv, c};
+            tri.normals.assign(3, {0, 0, 1});
+            tri.indices = {0, 1, 2};
+            const MeshId id = *r.upload(tri);
+            glm::mat4 frame(1.0f);
+            frame[0] = glm::vec4(u, 0.0f);
+            frame[1] = glm::vec4(v, 0.0f);
+            frame[2] = glm::vec4(0.0f, 0.0f, 1.0f, 0.0f);
+            frame[3] = glm::vec4(a, 1.0f);
+            const float cu = glm::dot(c - a, u), bu = glm::dot(bv - a, u);
+            // The box's edge on line AB ends beyond A and B, so it snaps unlike the triangle's.
+            const float before = 0.05f + 0.25f * height(rng), after = 0.05f + 0.25f * height(rng);
+            const Aabb local = Aabb::fromMinMax({std::min(0.0f, cu) - before, 0.0f, -0.2f},
+                                                {std::max(bu, cu) + after, glm::dot(c - a, v), 0.2f});
+            const QueryVolume volume = QueryVolume::fromTransformedBox(frame, local);
+
+            r.beginFrame(cam);
+            r.drawMesh(id, glm::mat4(1.0f), {1, 1, 1});
+            // Only pixels near line AB can be missed (elsewhere the box reaches far past the part).
+            const glm::dmat4 vp = cam.viewProjectionRelativeDouble();
+            auto toPixel = [&](const glm::vec3& w) {
+                const glm::dvec4 clip = vp * glm::dvec4(glm::dvec3(w) - glm::dvec3(cam.position), 1.0);
+                return glm::dvec2((clip.x / clip.w + 1.0) * 0.5 * kSize, (clip.y / clip.w + 1.0) * 0.5 * kSize);
+            };
+            const glm::dvec2 pa = toPixel(a), pb = toPixel(bv);
+            const glm::dvec2 dir = glm::normalize(pb - pa), nrm(-dir.y, dir.x);
+            for (const glm::ivec2 p : coveredPixels(r, kSize, kSize)) {
+                if (std::abs(glm::dot(glm::dvec2(p) + 0.5 - pa, nrm)) > 1.0) continue;
+                r.beginFrame(cam);
+                r.drawMesh(id, glm::mat4(1.0f), {1, 1, 1});
+                // Everything but pixel p nearest (reversed Z: 1), so only p can pass.
+                glEnable(GL_SCISSOR_TEST);
+                glClearDepth(1.0);
+                for (const glm::ivec4 rect : {glm::ivec4(0, 0, kSize, p.y), glm::ivec4(0, p.y + 1, kSize, kSize - p.y - 1),
+                                              glm::ivec4(0, p.y, p.x, 1), glm::ivec4(p.x + 1, p.y, kSize - p.x - 1, 1)}) {
+                    if (rect.z <= 0 || rect.w <= 0) continue;
+                    glScissor(rect.x, rect.y, rect.z, rect.w);
+                    glClear(GL_DEPTH_BUFFER_BIT);
+                }
+                glDisable(GL_SCISSOR_TEST);
+                glClearDepth(0.0);
+                b.beginFrame(cam, kSize, kSize);
+                b.beginBatch();
+                const QueryId q = b.issue(volume);
+                b.endBatch();
+                const bool seen = b.wait(q, 10000.0) == QueryResult::Visible;
+                b.release(q);
+                r.endFrame();
+                if (!seen) ++(ring ? missedWith : missedWithout);
+                if (ring) ++pixels;
+            }
+        }
+    }
+    std::printf("%u triangle pixels: %u missed by the tight volume alone, %u with the snapping ring\n", pixels,
+                missedWithout, missedWith);
+    EXPECT_GT(pixels, 10000u);
+    EXPECT_GT(missedWithout, 0u) << "the case the ring exists for should occur";
+    EXPECT_EQ(missedWith, 0u);
     EXPECT_EQ(ctx->checkErrors(), 0u);
 }
 

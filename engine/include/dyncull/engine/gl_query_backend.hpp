@@ -29,6 +29,11 @@ struct GlQueryParams {
     /// traverses on. On llvmpipe each flush ends a binned scene; off, the first poll of
     /// the batch submits it instead.
     bool flushAfterBatch = true;
+    /// Lay a flat ring a few 1/256 pixel wide around every volume's screen outline, at the
+    /// volume's nearest depth (detail::prepareVolume): the rasteriser's vertex snapping can
+    /// let a part cover a pixel centre just outside its tight volume's outline. Off only to
+    /// measure what the ring costs and what it catches.
+    bool snappingRing = true;
 };
 
 /// Owns GL query objects, a streaming vertex buffer for volumes and a depth-only program.
@@ -102,18 +107,15 @@ private:
     std::deque<QueryId> free_;
     std::uint64_t beginSerial_ = 0;     // glBeginQuery calls so far
     std::uint64_t answeredSerial_ = 0;  // largest `begun` of a query seen answered
-    std::uint32_t program_ = 0, boxVao_ = 0, meshVao_ = 0, vbo_ = 0, boxIbo_ = 0, meshIbo_ = 0;
+    std::uint32_t program_ = 0, vao_ = 0, vbo_ = 0, ibo_ = 0;
     int locViewProj_ = -1;
     std::uint32_t vboCapacity_ = 0;  // vertices
     std::uint32_t vboUsed_ = 0;      // vertices written this frame
-    std::uint32_t iboCapacity_ = 0;  // mesh indices (bytes)
-    std::uint32_t iboUsed_ = 0;      // mesh indices written this frame
-    bool boundMesh_ = false;         // meshVao_ (not boxVao_) bound in this batch
+    std::uint32_t iboCapacity_ = 0;  // 8-bit indices
+    std::uint32_t iboUsed_ = 0;      // indices written this frame
     glm::mat4 viewProj_{1.0f};       // camera-relative (Camera::viewProjectionRelative)
-    glm::dvec3 eye_{0.0};            // world-space eye; volumes are uploaded relative to it
-    glm::dvec3 forward_{0.0, 0.0, -1.0};  // unit view direction (world space)
-    double nearPlane_ = 0.0;         // view distance of the near plane
-    detail::VolumeView volumeView() const;
+    std::unique_ptr<detail::VolumeView> view_;  // this frame's camera; volumes are uploaded relative to its eye
+    int subpixelBits_ = 4;                      // GL_SUBPIXEL_BITS (4 is GL's minimum)
     std::unique_ptr<detail::VolumeTestState> rasterState_;  // entered by beginBatch, left by endBatch
     std::unique_ptr<detail::BatchedRasterTest> batches_;    // testVolumes / collectVolumes
     std::vector<QueryId> batchQuery_;  // per batch in flight: the query bracketing its draw
