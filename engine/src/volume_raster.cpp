@@ -1,4 +1,5 @@
-// The raster state shared by the GL volume tests (volume_raster.hpp).
+// What the GL volume tests share (volume_raster.hpp): a volume's drawn points and
+// triangles with its snapping ring, and the raster state they are drawn in.
 #include "volume_raster.hpp"
 
 #include <span>
