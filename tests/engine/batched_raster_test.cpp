@@ -225,7 +225,8 @@ TEST(VolumeSnapping, TheRingKeepsEveryPixelOfAPartInsideItsVolume) {
 
             r.beginFrame(cam);
             r.drawMesh(id, glm::mat4(1.0f), {1, 1, 1});
-            // Only pixels near line AB can be missed (elsewhere the box reaches far past the part).
+            // Only pixel centres within a few snapping steps of line AB can be missed (elsewhere
+            // the box reaches past the part by more than snapping moves an edge).
             const glm::dmat4 vp = cam.viewProjectionRelativeDouble();
             auto toPixel = [&](const glm::vec3& w) {
                 const glm::dvec4 clip = vp * glm::dvec4(glm::dvec3(w) - glm::dvec3(cam.position), 1.0);
@@ -234,7 +235,7 @@ TEST(VolumeSnapping, TheRingKeepsEveryPixelOfAPartInsideItsVolume) {
             const glm::dvec2 pa = toPixel(a), pb = toPixel(bv);
             const glm::dvec2 dir = glm::normalize(pb - pa), nrm(-dir.y, dir.x);
             for (const glm::ivec2 p : coveredPixels(r, kSize, kSize)) {
-                if (std::abs(glm::dot(glm::dvec2(p) + 0.5 - pa, nrm)) > 1.0) continue;
+                if (std::abs(glm::dot(glm::dvec2(p) + 0.5 - pa, nrm)) > 0.02) continue;
                 r.beginFrame(cam);
                 r.drawMesh(id, glm::mat4(1.0f), {1, 1, 1});
                 // Everything but pixel p nearest (reversed Z: 1), so only p can pass.
@@ -260,9 +261,9 @@ TEST(VolumeSnapping, TheRingKeepsEveryPixelOfAPartInsideItsVolume) {
             }
         }
     }
-    std::printf("%u triangle pixels: %u missed by the tight volume alone, %u with the snapping ring\n", pixels,
+    std::printf("%u triangle pixels near the shared edge: %u missed by the tight volume alone, %u with the snapping ring\n", pixels,
                 missedWithout, missedWith);
-    EXPECT_GT(pixels, 10000u);
+    EXPECT_GT(pixels, 100u);
     EXPECT_GT(missedWithout, 0u) << "the case the ring exists for should occur";
     EXPECT_EQ(missedWith, 0u);
     EXPECT_EQ(ctx->checkErrors(), 0u);
