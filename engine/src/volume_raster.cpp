@@ -55,7 +55,7 @@ void addRing(std::span<const glm::dvec3> rel, const VolumeView& view, DrawnVolum
     };
     auto quad = [&](const glm::dvec2& a, const glm::dvec2& b, const glm::dvec2& c, const glm::dvec2& d) {
         const std::uint8_t i0 = emit(a), i1 = emit(b), i2 = emit(c), i3 = emit(d);
-        for (std::uint8_t i : {i0, i1, i2, i0, i2, i3}) out.indices[out.indexCount++] = i;
+        for (std::uint8_t i : {i0, i1, i2, i0, i2, i3}) out.indices[out.indexCount++] = i;  // a, b, c, d counter-clockwise
     };
     if (h == 1 || (h == 2 && screen[hull[0]] == screen[hull[1]])) {  // every point on one spot: a square around it
         const glm::dvec2 c = screen[hull[0]];
@@ -68,7 +68,7 @@ void addRing(std::span<const glm::dvec3> rel, const VolumeView& view, DrawnVolum
     for (std::uint32_t k = 0; k < h; ++k) {
         const glm::dvec2 a = screen[hull[k]], b = screen[hull[(k + 1) % h]];
         const glm::dvec2 t = glm::normalize(b - a), n(t.y, -t.x);  // outward for counter-clockwise
-        quad(a - w * t - w * n, b + w * t - w * n, b + w * t + w * n, a - w * t + w * n);
+        quad(a - w * t + w * n, b + w * t + w * n, b + w * t - w * n, a - w * t - w * n);
     }
 }
 
@@ -83,7 +83,21 @@ bool prepareVolume(const QueryVolume& volume, const VolumeView& view, DrawnVolum
         out.points[i] = glm::vec3(rel[i]);
     }
     const std::span<const std::uint8_t> tris = asBox || volume.isBox() ? std::span<const std::uint8_t>(kBoxTriangles) : volume.triangles();
-    std::copy(tris.begin(), tris.end(), out.indices.begin());
+    // Only front faces are drawn (VolumeTestState): they cover the whole outline of a
+    // convex volume seen from outside (one reaching the near plane was answered above),
+    // and a back face lies behind the front face of its pixel. Each face is wound outward
+    // from the volume's centre here, whatever order it came in (a mirroring object matrix
+    // turns outward winding inward).
+    glm::dvec3 centre(0.0);
+    for (std::uint32_t i = 0; i < out.count; ++i) centre += rel[i];
+    centre /= double(out.count);
+    for (std::size_t k = 0; k + 2 < tris.size(); k += 3) {
+        const glm::dvec3 &a = rel[tris[k]], &b = rel[tris[k + 1]], &c = rel[tris[k + 2]];
+        const bool inward = glm::dot(a - centre, glm::cross(b - a, c - a)) < 0.0;
+        out.indices[k] = tris[k];
+        out.indices[k + 1] = tris[inward ? k + 2 : k + 1];
+        out.indices[k + 2] = tris[inward ? k + 1 : k + 2];
+    }
     out.indexCount = static_cast<std::uint32_t>(tris.size());
     if (view.ringPixels > 0.0) addRing({rel.data(), out.count}, view, out);
     return true;
@@ -96,6 +110,8 @@ void VolumeTestState::enter() {
     glGetFloatv(GL_POLYGON_OFFSET_FACTOR, &offsetFactor_);
     glGetFloatv(GL_POLYGON_OFFSET_UNITS, &offsetUnits_);
     cull_ = glIsEnabled(GL_CULL_FACE);
+    glGetIntegerv(GL_CULL_FACE_MODE, &cullMode_);
+    glGetIntegerv(GL_FRONT_FACE, &frontFace_);
     depthTest_ = glIsEnabled(GL_DEPTH_TEST);
     offsetFill_ = glIsEnabled(GL_POLYGON_OFFSET_FILL);
 
@@ -103,7 +119,9 @@ void VolumeTestState::enter() {
     glDepthMask(GL_FALSE);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(kDepthNearerOrEqual);
-    glDisable(GL_CULL_FACE);
+    glEnable(GL_CULL_FACE);  // see prepareVolume: front faces suffice, at half the fragments
+    glCullFace(GL_BACK);
+    glFrontFace(GL_CCW);
     // Pull volumes toward the eye by a few depth-buffer steps (scaled by GL to the face's
     // depth slope and the buffer's resolution): a part lying on its box face, or a
     // coplanar occluder, must not win a depth tie against the volume and hide a visible
@@ -120,7 +138,9 @@ void VolumeTestState::leave() {
     glDepthFunc(static_cast<GLenum>(depthFunc_));
     glPolygonOffset(offsetFactor_, offsetUnits_);
     if (!offsetFill_) glDisable(GL_POLYGON_OFFSET_FILL);
-    if (cull_) glEnable(GL_CULL_FACE);
+    glCullFace(static_cast<GLenum>(cullMode_));
+    glFrontFace(static_cast<GLenum>(frontFace_));
+    if (!cull_) glDisable(GL_CULL_FACE);
     if (!depthTest_) glDisable(GL_DEPTH_TEST);
 }
 

@@ -65,7 +65,8 @@ bool prepareVolume(const QueryVolume& volume, const VolumeView& view, DrawnVolum
 
 /// The raster state of a volume test, entered and left around the draws: colour and depth
 /// writes off, depth test nearer-or-equal (a face coplanar with drawn geometry counts as
-/// visible), both sides drawn, and the volume pulled toward the eye by a few depth steps.
+/// visible), back faces culled (counter-clockwise fronts in window coordinates, y up, as
+/// prepareVolume orients them), and the volume pulled toward the eye by a few depth steps.
 /// Saves what it changes and restores it.
 class VolumeTestState {
 public:
@@ -75,7 +76,7 @@ public:
 private:
     GLboolean colourMask_[4] = {GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE};
     GLboolean depthMask_ = GL_TRUE;
-    GLint depthFunc_ = 0;
+    GLint depthFunc_ = 0, cullMode_ = GL_BACK, frontFace_ = GL_CCW;
     GLfloat offsetFactor_ = 0.0f, offsetUnits_ = 0.0f;
     bool cull_ = false, depthTest_ = false, offsetFill_ = false;
 };

@@ -59,7 +59,7 @@ QueryVolume octahedron(const glm::vec3& centre, const glm::vec3& half) {
         v.vertices[2 * a] = centre - d;
         v.vertices[2 * a + 1] = centre + d;
     }
-    // Faces: one vertex from each axis pair; winding is irrelevant (both sides drawn).
+    // Faces: one vertex from each axis pair, wound either way (the backend orients them).
     v.triangleCount = 8;
     for (int f = 0; f < 8; ++f) {
         v.indices[3 * f] = static_cast<std::uint8_t>(0 + ((f >> 0) & 1));
@@ -95,6 +95,48 @@ TEST(OcclusionQuery, BackendMeshVolumesAndVolumesReachingTheNearPlane) {
     EXPECT_EQ(b.wait(behind, 10000.0), QueryResult::Occluded);
     EXPECT_EQ(b.wait(inFront, 10000.0), QueryResult::Visible);
     for (QueryId id : {behind, inFront, throughNear}) b.release(id);
+    r.endFrame();
+    EXPECT_EQ(ctx->checkErrors(), 0u);
+}
+
+// The backend draws front faces only, so it must find them itself: a volume whose faces
+// are all wound inward, or mixed, covers exactly the samples of the outward one. A wall
+// through the volume's middle hides its back half, which wrongly wound faces would draw.
+TEST(OcclusionQuery, VolumesCoverTheSameSamplesWhateverTheirWinding) {
+    auto ctx = test::headless();
+    ASSERT_TRUE(ctx);
+    auto backendOr = GlQueryBackend::create(*ctx, {.visiblePixelThreshold = 1});
+    ASSERT_TRUE(backendOr.ok()) << backendOr.error().message;
+    GlQueryBackend& b = **backendOr;
+    const Camera cam = test::cameraOnZ(3.0f);
+    auto made = Renderer::create(*ctx);
+    ASSERT_TRUE(made.ok()) << made.error().message;
+    Renderer& r = **made;
+    const MeshId wall = *r.upload(test::quadMesh(5.0f));  // fills the whole view at z = 0
+    r.beginFrame(cam);
+    r.drawMesh(wall, glm::mat4(1.0f), {0.5f, 0.5f, 0.5f});
+    b.beginFrame(cam, test::kW, test::kH);
+    const QueryVolume mixed = octahedron({0.2f, -0.1f, 0.0f}, {0.6f, 0.4f, 0.5f});
+    QueryVolume outward = mixed, inward = mixed;
+    for (std::uint32_t t = 0; t < mixed.triangleCount; ++t) {
+        const glm::vec3 a = mixed.vertices[mixed.indices[3 * t]], bb = mixed.vertices[mixed.indices[3 * t + 1]],
+                        c = mixed.vertices[mixed.indices[3 * t + 2]];
+        const bool out = glm::dot(a - glm::vec3(0.2f, -0.1f, 0.0f), glm::cross(bb - a, c - a)) > 0.0f;
+        std::swap(outward.indices[3 * t + 1], outward.indices[3 * t + (out ? 1 : 2)]);
+        std::swap(inward.indices[3 * t + 1], inward.indices[3 * t + (out ? 2 : 1)]);
+    }
+    b.beginBatch();
+    const QueryId ids[3] = {b.issue(outward), b.issue(inward), b.issue(mixed)};
+    b.endBatch();
+    std::uint64_t samples[3];
+    for (int i = 0; i < 3; ++i) {
+        ASSERT_EQ(b.wait(ids[i], 10000.0), QueryResult::Visible);
+        samples[i] = b.samples(ids[i]);
+        b.release(ids[i]);
+    }
+    EXPECT_GT(samples[0], 200u);  // of 64x64 pixels
+    EXPECT_EQ(samples[1], samples[0]);
+    EXPECT_EQ(samples[2], samples[0]);
     r.endFrame();
     EXPECT_EQ(ctx->checkErrors(), 0u);
 }

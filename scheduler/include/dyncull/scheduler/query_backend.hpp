@@ -31,8 +31,9 @@ struct QueryVolume {
 
     std::array<glm::vec3, kMaxVertices> vertices;  ///< world space, [0, vertexCount) used
     std::uint32_t vertexCount = 0;
-    /// 3 per triangle, into `vertices`, counter-clockwise seen from outside (backends draw
-    /// both sides anyway); [0, 3 * triangleCount) used. 0 triangles: a box.
+    /// 3 per triangle, into `vertices`, counter-clockwise seen from outside (backends do
+    /// not rely on it: the GL backend winds each face outward from the centre itself);
+    /// [0, 3 * triangleCount) used. 0 triangles: a box.
     std::array<std::uint8_t, 3 * kMaxTriangles> indices;
     std::uint32_t triangleCount = 0;
 
