@@ -49,7 +49,7 @@ ModeSpec fullMode(const std::string& name) {
 }  // namespace
 
 std::string modeNamesHelp() {
-    return "vfc, simple, full, twophase (draw last frame's visible parts, test the rest against their depth pyramid, then what it cannot reject in one batched raster test), twophase-hzb (the pyramid alone), oracle; approximate: thrN (pixel threshold), latency1 (last frame's results), "
+    return "vfc, simple, full, twophase (draw last frame's visible parts, test the rest against their depth pyramid, then what it cannot reject in one batched raster test), twophase-hzb (the pyramid alone), twophase-nohist (every part drawn early tested again each frame), twophase-nocost (every volume the pyramid lets through tested), oracle; approximate: thrN (pixel threshold), latency1 (last frame's results), "
            "skipN (history max skip N, 2 per visible), overlap (overlapping batches), smallN (small-feature pixels); "
            "backend: noflush (no glFlush after each batch); "
            "conservative: frontN (front-most N% of leaves drawn without queries); "
@@ -160,9 +160,11 @@ Expected<ModeSpec> modeFromName(const std::string& name) {
         m.scheduler.mode = CullMode::Vfc;
     } else if (name == "simple") {
         m.scheduler.mode = CullMode::Simple;
-    } else if (name == "twophase" || name == "twophase-hzb") {
+    } else if (name == "twophase" || name == "twophase-hzb" || name == "twophase-nohist" || name == "twophase-nocost") {
         m.scheduler.mode = CullMode::TwoPhase;
-        m.scheduler.useBatchedRaster = name == "twophase";
+        m.scheduler.useBatchedRaster = name != "twophase-hzb";
+        m.scheduler.useHistory = name != "twophase-nohist";
+        m.scheduler.useCostModel = name != "twophase-nocost";
     } else if (name == "oracle") {
         m.oracle = true;
     } else {
@@ -358,7 +360,8 @@ FalsePositiveCauses BenchRunner::falsePositiveCauses() const {
             case NodeState::VisibleOccupancy: ++c.occupancy; break;
             case NodeState::VisibleNear:
             case NodeState::VisibleFront:
-            case NodeState::VisibleVfc: ++c.other; break;
+            case NodeState::VisibleVfc:
+            case NodeState::VisibleCheaper: ++c.other; break;
         }
     }
     return c;

@@ -177,7 +177,7 @@ Status writeFramesCsv(const BenchResult& r, const fs::path& path) {
          "pixels_wrong,pixels_wrong_pct,largest_wrong_region,frame_update_ms,ground_truth_ms,ground_truth_artefact_pixels,"
          "draw_queries,draw_queries_occluded,draw_queries_late,false_positives_queried,false_positives_history,"
          "false_positives_occupancy,false_positives_other,visible_triangles,bound_aabb_parts,bound_aabb_triangles,"
-         "bound_auto_parts,bound_auto_triangles,depth_tests,ms_depth_read,raster_tests,raster_batches,ms_raster\n";
+         "bound_auto_parts,bound_auto_triangles,depth_tests,ms_depth_read,raster_tests,raster_batches,ms_raster,skipped_cost\n";
     for (std::size_t i = 0; i < r.frames.size(); ++i) {
         const FrameTruth& t = r.truth[i];
         for (std::size_t m = 0; m < r.modes.size(); ++m) {
@@ -201,7 +201,7 @@ Status writeFramesCsv(const BenchResult& r, const fs::path& path) {
             else
                 f << ",,,,";  // not measured
             f << ',' << s.depthTests << ',' << s.depthReadMs << ',' << s.rasterTests << ',' << s.rasterBatches << ','
-              << s.rasterMs << '\n';
+              << s.rasterMs << ',' << s.skippedByCost << '\n';
         }
     }
     return closeChecked(f, path);

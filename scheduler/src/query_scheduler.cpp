@@ -40,6 +40,7 @@ const char* toString(NodeState s) {
         case NodeState::VisibleNear: return "visible_near";
         case NodeState::VisibleFront: return "visible_front";
         case NodeState::VisibleVfc: return "visible_vfc";
+        case NodeState::VisibleCheaper: return "visible_cheaper";
     }
     return "?";
 }
@@ -60,6 +61,9 @@ Status validateSchedulerParams(const SchedulerParams& p) {
     if (!(p.frontPercent >= 0.0f && p.frontPercent <= 100.0f)) return Error{"frontPercent must be in [0, 100]"};
     if (!(p.autoVolumeSaving >= 0.0f && p.autoVolumeSaving <= 1.0f)) return Error{"autoVolumeSaving must be in [0, 1]"};
     if (static_cast<int>(p.volume) > static_cast<int>(VolumeChoice::Auto)) return Error{"volume has an unknown value"};
+    for (double c : {p.costs.drawNsPerTriangle, p.costs.testNsPerVolume, p.costs.testNsPerPixel, p.costs.depthReadNs})
+        if (!(c >= 0.0 && c < 1e12)) return Error{"costs must be finite and non-negative (nanoseconds)"};
+    if (p.costs.probeFrames == 0) return Error{"costs.probeFrames must be at least 1"};
     return {};
 }
 

@@ -7,8 +7,12 @@
 //     skipped;
 //  4. the parts the pyramid let through are tested exactly, per pixel, in one batched
 //     raster test against the early depth (NVIDIA's gl_occlusion_culling "temporal current
-//     frame" scheme) and the visible ones drawn; then every part drawn is tested against
+//     frame" scheme) and the visible ones drawn; then the parts drawn are tested against
 //     the final depth, and those visible there are next frame's early set.
+// Which volumes are tested is CHC++'s question (Mattausch et al. 2008, sections 3-4: test
+// only where it pays, and visible nodes only every few frames): a cost model weighs a
+// test's pixels against the part's triangles and the measured rate of tests that cull,
+// and a part drawn early is tested again only when its visibility history says so.
 // Conservative: whatever is not drawn was hidden behind depth that the final image also
 // has (the early parts are drawn, and depth only grows nearer afterwards).
 #include <algorithm>
@@ -76,20 +80,27 @@ void QueryScheduler::runTwoPhase() {
         }
     }
 
-    // 2. The early pass's depth. A backend that cannot read depth leaves the pyramid
-    // unbuilt, and an unbuilt pyramid calls nothing occluded.
-    const auto t0 = Clock::now();
-    int w = 0, hgt = 0;
-    const bool haveDepth = backend_->readDepth(depth_, w, hgt) && w == width_ && hgt == height_;
-    if (haveDepth) pyramid_.build(depth_, w, hgt);
-    stats_->depthReadMs += msSince(t0);
+    // 2. The early pass's depth, unless the cost model turned this frame's tests off. A
+    // backend that cannot read depth leaves the pyramid unbuilt, and an unbuilt pyramid
+    // calls nothing occluded.
+    const bool testing = !params_.useCostModel || savedNs_ > params_.costs.depthReadNs ||
+                         frame_ - lastTestedFrame_ >= params_.costs.probeFrames;
+    culledTriangles_ = 0;
+    bool haveDepth = false;
+    if (testing) {
+        const auto t0 = Clock::now();
+        int w = 0, hgt = 0;
+        haveDepth = backend_->readDepth(depth_, w, hgt) && w == width_ && hgt == height_;
+        if (haveDepth) pyramid_.build(depth_, w, hgt);
+        stats_->depthReadMs += msSince(t0);
+    }
 
     // 3. Late pass. Parts the pyramid cannot reject are either drawn at once or, with the
     // batched raster test, collected in `candidates_` and tested exactly afterwards; the
     // parts drawn early are collected in `refresh_` to be tested against the final depth.
     candidates_.clear();
     refresh_.clear();
-    const bool raster = params_.useBatchedRaster;
+    const bool raster = params_.useBatchedRaster && testing;
     if (!(root == NodeRef{})) active_.push_back(root);
     while (!active_.empty()) {
         const NodeRef ref = active_.back();
@@ -126,11 +137,12 @@ void QueryScheduler::runTwoPhase() {
             h.lastVisible = false;
             note(NodeState::FrustumCulled);
             continue;
-        } else {
+        } else if (haveDepth) {
             ++stats_->depthTests;
-            if (haveDepth && pyramid_.occluded(rect, nearest)) {
+            if (pyramid_.occluded(rect, nearest)) {
                 ++stats_->queriesOccluded;
-                h.lastVisible = false;
+                culledTriangles_ += subtreeTriangles(ref);
+                history_.recordAnswer(h, false, frame_);
                 note(NodeState::Occluded);
                 continue;
             }
@@ -143,11 +155,24 @@ void QueryScheduler::runTwoPhase() {
             tree_->expand(ref, camera_.position, scratch_);
             for (auto it = scratch_.rbegin(); it != scratch_.rend(); ++it) active_.push_back(*it);
         } else if (drawnEarly) {
-            if (raster && !certain) refresh_.push_back({ref, volume});
-        } else if (raster && !certain) {
+            if (!raster || certain) continue;
+            // Visibility history, as in Full: a part that kept answering "visible" is
+            // tested again only after the frames its answers earn. The cost model may
+            // postpone it further, but not past history's longest postponement, so every
+            // part is tested now and then and the rate of culling tests stays measured.
+            const std::uint32_t sinceAnswer = frame_ - h.lastQueryFrame;
+            if (params_.useHistory && sinceAnswer <= history_.postponement(ref, h, params_.history)) {
+                ++stats_->skippedByHistory;
+            } else if (sinceAnswer <= params_.history.maxSkipFrames && !worthTesting(ref, rect, refreshOccludedRate_)) {
+                ++stats_->skippedByCost;
+            } else {
+                refresh_.push_back({ref, volume});
+            }
+        } else if (raster && !certain && (worthTesting(ref, rect, candidateOccludedRate_) || exploring(ref))) {
             candidates_.push_back({ref, volume});
         } else {
-            note(certain ? NodeState::VisibleNear : NodeState::VisibleQueried);
+            if (raster && !certain) ++stats_->skippedByCost;
+            note(certain ? NodeState::VisibleNear : testing && !raster ? NodeState::VisibleQueried : NodeState::VisibleCheaper);
             drawNode(ref, false);
         }
     }
@@ -156,14 +181,21 @@ void QueryScheduler::runTwoPhase() {
     // parts the pyramid let through; then every part drawn after a test (early, or late
     // after this one) against the final depth: one hidden there is not drawn early next
     // frame (the first frame, which has no early set, would otherwise draw everything twice).
+    // The rates the cost model sees move a quarter of the way to each batch's answers.
+    auto learn = [](double& rate, const std::vector<QueryResult>& answers) {
+        const auto occluded = std::count(answers.begin(), answers.end(), QueryResult::Occluded);
+        rate += 0.25 * (double(occluded) / double(answers.size()) - rate);
+    };
     if (!candidates_.empty()) {
         rasterTest(candidates_);
+        learn(candidateOccludedRate_, rasterAnswers_);
         for (std::size_t i = 0; i < candidates_.size(); ++i) {
             const NodeRef ref = candidates_[i].ref;
             NodeHistory& h = history_.at(ref, objs);
             if (rasterAnswers_[i] == QueryResult::Occluded) {
                 ++stats_->queriesOccluded;
-                h.lastVisible = false;
+                culledTriangles_ += subtreeTriangles(ref);
+                history_.recordAnswer(h, false, frame_);
                 trace(ref, tree_->worldBox(ref), NodeState::Occluded);
             } else {
                 trace(ref, tree_->worldBox(ref), NodeState::VisibleQueried);
@@ -174,9 +206,50 @@ void QueryScheduler::runTwoPhase() {
     }
     if (!refresh_.empty()) {
         rasterTest(refresh_);
-        for (std::size_t i = 0; i < refresh_.size(); ++i)
-            if (rasterAnswers_[i] == QueryResult::Occluded) history_.at(refresh_[i].ref, objs).lastVisible = false;
+        learn(refreshOccludedRate_, rasterAnswers_);
+        for (std::size_t i = 0; i < refresh_.size(); ++i) {
+            const bool visible = rasterAnswers_[i] != QueryResult::Occluded;
+            if (!visible) culledTriangles_ += subtreeTriangles(refresh_[i].ref);  // not drawn early next frame
+            history_.recordAnswer(history_.at(refresh_[i].ref, objs), visible, frame_);
+        }
     }
+    if (testing) {
+        lastTestedFrame_ = frame_;
+        savedNs_ = double(culledTriangles_) * params_.costs.drawNsPerTriangle;
+    }
+}
+
+bool QueryScheduler::worthTesting(NodeRef ref, const ScreenRect& rect, double occludedRate) const {
+    if (!params_.useCostModel) return true;
+    const SceneObjects& objs = tree_->objects();
+    const double triangles = objs.model(objs.modelOf(ref.object)).nodes[ref.node].indexCount / 3;
+    const SchedulerParams::TestCosts& c = params_.costs;
+    return occludedRate * triangles * c.drawNsPerTriangle > c.testNsPerVolume + c.testNsPerPixel * rect.area();
+}
+
+std::uint64_t QueryScheduler::subtreeTriangles(NodeRef ref) {
+    const SceneObjects& objs = tree_->objects();
+    auto objectTriangles = [&](std::uint32_t object, std::uint32_t node) {
+        return std::uint64_t{objs.model(objs.modelOf(object)).nodes[node].indexCount / 3};
+    };
+    if (!ref.isSceneNode()) return objectTriangles(ref.object, ref.node);
+    const LooseBsp& scene = tree_->scene();
+    std::uint64_t triangles = 0;
+    scratchIndices_.assign(1, ref.node);
+    while (!scratchIndices_.empty()) {
+        const LooseBspNode& n = scene.nodes()[scratchIndices_.back()];
+        scratchIndices_.pop_back();
+        for (std::uint32_t o = n.firstObject; o != kInvalidIndex; o = scene.nextObject(o)) triangles += objectTriangles(o, 0);
+        if (!n.isLeaf()) scratchIndices_.insert(scratchIndices_.end(), {n.children[0], n.children[1]});
+    }
+    return triangles;
+}
+
+bool QueryScheduler::exploring(NodeRef ref) const {
+    // One new part in eight, a different eighth each frame, is tested whatever the model
+    // expects, so a rate that fell while nothing was occluded can rise again.
+    const std::uint32_t hash = (ref.object * 2654435761u) ^ (ref.node * 2246822519u);
+    return ((hash >> 5) + frame_) % 8 == 0;
 }
 
 void QueryScheduler::rasterTest(const std::vector<TestedPart>& parts) {

@@ -58,14 +58,18 @@ bool VisibilityHistory::canSkipQuery(NodeRef ref, const NodeHistory& h, std::uin
     // Only a node reached and visible in the previous frame may skip ("invisible last
     // time -> query"); a node not reached last frame (parent culled) was not visible.
     if (!h.lastVisible || h.lastTouchedFrame + 1 != frame) return false;
+    return frame - h.lastQueryFrame <= postponement(ref, h, p);
+}
+
+std::uint32_t VisibilityHistory::postponement(NodeRef ref, const NodeHistory& h, const HistoryParams& p) const {
     const std::uint32_t visibleAnswers = static_cast<std::uint32_t>(std::popcount(h.bits));
-    if (visibleAnswers < p.minVisibleToSkip) return false;
+    if (visibleAnswers < p.minVisibleToSkip) return 0;
     std::uint32_t skip = std::min(p.maxSkipFrames, p.skipFramesPerVisible * visibleAnswers);
     if (p.jitter && skip >= 2) {
         const std::uint32_t hash = (ref.object * 2654435761u) ^ (ref.node * 2246822519u) ^ 0x9e3779b9u;
         skip -= (hash >> 7) % (skip / 2 + 1);
     }
-    return frame - h.lastQueryFrame <= skip;
+    return skip;
 }
 
 std::size_t VisibilityHistory::memoryBytes() const {

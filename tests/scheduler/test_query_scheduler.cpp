@@ -869,3 +869,135 @@ TEST(QueryFaults, AnswersForARemovedObjectAreDroppedWhenItsSlotIsReused) {
     // Every cube is new: nothing known about it, so it is drawn while its query is in flight.
     EXPECT_EQ(std::set<std::uint32_t>(sink.drawn.begin(), sink.drawn.end()), cubes);
 }
+
+namespace {
+
+/// Two-phase's backend without GL: a depth buffer of one value everywhere (reversed Z: 0
+/// is far, nothing occluded; 1 is the near plane, everything occluded) and batched raster
+/// tests answered by `rule`. Counts depth reads and tested volumes.
+struct DepthBackend final : QueryBackend {
+    float depth = 0.0f;
+    std::function<QueryResult(const QueryVolume&)> rule = [](const QueryVolume&) { return QueryResult::Visible; };
+    int reads = 0, tested = 0;
+    std::vector<std::vector<QueryResult>> answers;  // per batch, until collected
+
+    void beginFrame(const Camera&, int, int) override {}
+    void beginBatch() override { ADD_FAILURE() << "two-phase issues no hardware query"; }
+    QueryId issue(const QueryVolume&) override { return 0; }
+    void endBatch() override {}
+    QueryResult poll(QueryId) override { return QueryResult::Visible; }
+    QueryResult wait(QueryId, double) override { return QueryResult::Visible; }
+    void release(QueryId) override {}
+    bool readDepth(std::vector<float>& d, int& w, int& h) override {
+        ++reads;
+        w = 640;
+        h = 320;
+        d.assign(std::size_t{640} * 320, depth);
+        return true;
+    }
+    BatchId testVolumes(std::span<const QueryVolume> volumes) override {
+        tested += static_cast<int>(volumes.size());
+        answers.emplace_back();
+        for (const QueryVolume& v : volumes) answers.back().push_back(rule(v));
+        return static_cast<BatchId>(answers.size() - 1);
+    }
+    bool collectVolumes(BatchId id, std::span<QueryResult> out, double) override {
+        EXPECT_EQ(out.size(), answers[id].size());
+        std::copy(answers[id].begin(), answers[id].end(), out.begin());
+        return true;
+    }
+};
+
+SchedulerParams twoPhase() {
+    SchedulerParams p;
+    p.mode = CullMode::TwoPhase;
+    return p;
+}
+
+}  // namespace
+
+// Where the tests cull nothing (Sponza's case), the cost model stops reading depth back
+// after the first frame and tries again every probeFrames frames; once occlusion appears,
+// the next probe finds it and testing resumes. Every frame draws at least what vfc draws
+// while nothing is occluded.
+TEST(TwoPhaseCosts, TestsStopWhereTheyCullNothingAndResumeWhenTheyWould) {
+    TestScene s(4, 3);
+    const auto reference = vfcDrawn(s);
+    DepthBackend backend;
+    SchedulerParams p = twoPhase();
+    p.costs.probeFrames = 8;
+    p.costs.depthReadNs = 1000.0;  // less than drawing this small scene's 144 triangles
+    QueryScheduler sched(p);
+    TwoLevelTree tree(s.bsp, s.objects);
+    std::vector<std::uint32_t> testedFrames;
+    for (std::uint32_t f = 1; f <= 20; ++f) {
+        RecordingSink sink;
+        const int before = backend.reads;
+        sched.cullFrame(tree, frontCamera(), 640, 320, backend, sink);
+        if (backend.reads > before) testedFrames.push_back(f);
+        EXPECT_EQ(sink.drawn, reference) << "frame " << f;
+    }
+    EXPECT_EQ(testedFrames, (std::vector<std::uint32_t>{1, 9, 17}));
+
+    // Everything is hidden from now on: the probe at frame 25 finds it, and from the frame
+    // after it nothing is drawn.
+    backend.depth = 1.0f;
+    backend.rule = [](const QueryVolume&) { return QueryResult::Occluded; };
+    std::size_t drawnAt26 = 99, drawnAt27 = 99;
+    for (std::uint32_t f = 21; f <= 27; ++f) {
+        RecordingSink sink;
+        sched.cullFrame(tree, frontCamera(), 640, 320, backend, sink);
+        if (f < 25) {
+            EXPECT_EQ(sink.drawn, reference) << "frame " << f;  // tests still off
+        }
+        if (f == 26) drawnAt26 = sink.drawn.size();
+        if (f == 27) drawnAt27 = sink.drawn.size();
+    }
+    EXPECT_EQ(drawnAt26, 0u);
+    EXPECT_EQ(drawnAt27, 0u);
+
+    // The ablation tests every frame.
+    p.useCostModel = false;
+    QueryScheduler always(p);
+    DepthBackend b2;
+    for (int f = 0; f < 5; ++f) {
+        RecordingSink sink;
+        always.cullFrame(tree, frontCamera(), 640, 320, b2, sink);
+    }
+    EXPECT_EQ(b2.reads, 5);
+}
+
+// A part is tested only if the drawing it may save outweighs the test: with drawing free,
+// only the exploring eighth is tested and the rest drawn untested (VisibleCheaper); with
+// drawing dear, every part the pyramid lets through is tested.
+TEST(TwoPhaseCosts, PartsAreTestedOnlyWhereTheTestPays) {
+    TestScene s(6, 4);
+    const auto reference = vfcDrawn(s);
+    TwoLevelTree tree(s.bsp, s.objects);
+    for (double ns : {0.0, 1e6}) {
+        SchedulerParams p = twoPhase();
+        p.costs.drawNsPerTriangle = ns;
+        QueryScheduler sched(p);
+        DepthBackend backend;
+        RecordingSink sink;
+        std::vector<NodeTrace> trace;
+        sched.setTrace(&trace);
+        const FrameStats st = sched.cullFrame(tree, frontCamera(), 640, 320, backend, sink);
+        EXPECT_EQ(sink.drawn, reference);
+        std::size_t cheaper = 0, queried = 0;
+        for (const NodeTrace& t : trace) {
+            if (t.ref.isSceneNode()) continue;
+            cheaper += t.state == NodeState::VisibleCheaper;
+            queried += t.state == NodeState::VisibleQueried;
+        }
+        if (ns == 0.0) {
+            EXPECT_LT(backend.tested, static_cast<int>(reference.size()) / 2) << "only the exploring parts";
+            EXPECT_EQ(cheaper, st.skippedByCost);
+            EXPECT_GT(cheaper, reference.size() / 2);
+        } else {
+            EXPECT_EQ(cheaper, 0u);
+            EXPECT_EQ(st.skippedByCost, 0u);
+            EXPECT_GE(queried, reference.size());
+        }
+    }
+}

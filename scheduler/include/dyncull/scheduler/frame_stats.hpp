@@ -26,6 +26,7 @@ struct FrameStats {
     std::uint32_t drawQueriesOccluded = 0;  ///< last frame's draw queries read this frame that drew no sample
     std::uint32_t drawQueriesLate = 0;      ///< last frame's draw queries still unanswered at this frame's end (dropped)
     std::uint32_t skippedByHistory = 0;  ///< queries not issued thanks to visibility history
+    std::uint32_t skippedByCost = 0;  ///< two-phase: volumes left untested by the cost model (SchedulerParams::useCostModel)
     std::uint32_t skippedByOccupancy = 0;  ///< visible without a query: rectangle touched empty screen
     std::uint32_t visibleNearOrInside = 0;  ///< visible without a query: camera inside / near plane crossed
     std::uint32_t visibleFront = 0;  ///< visible without a query: front-most leaves (SchedulerParams::frontPercent)

@@ -104,6 +104,30 @@ struct SchedulerParams {
     /// that turned hidden is not drawn early next frame. Off: such parts are drawn (the
     /// pyramid alone, an ablation).
     bool useBatchedRaster = true;
+
+    /// TwoPhase's cost model: a volume the pyramid cannot reject is tested only where the
+    /// test is expected to pay. Its cost is `testNsPerVolume` plus `testNsPerPixel` per
+    /// pixel of its screen rectangle; what it saves is the part's triangles times
+    /// `drawNsPerTriangle`, times the measured rate at which such tests answer "occluded"
+    /// (kept per kind: parts new this frame, and parts drawn early being tested again).
+    /// Otherwise the part is simply drawn. The same model turns a frame's tests off (no
+    /// depth readback, no test: every part in the frustum drawn) while the last frame
+    /// tested culled less drawing than `depthReadNs`, the readback and the stall it causes
+    /// (the late pass cannot start before the early pass is rasterised); it tests again
+    /// every `probeFrames` frames to see whether that has changed. Costs in nanoseconds of
+    /// GL time; the defaults were measured on llvmpipe at 640x360 (`bench_draw_speed`,
+    /// `bench_volume_tests`, and for the readback `twophase-hzb` against `vfc` on Sponza;
+    /// docs/BENCHMARKS.md), and another GL needs its own.
+    struct TestCosts {
+        double drawNsPerTriangle = 53.0;
+        double testNsPerVolume = 5000.0;
+        double testNsPerPixel = 1.5;
+        double depthReadNs = 400000.0;
+        std::uint32_t probeFrames = 16;
+    };
+    TestCosts costs;
+    /// Off: every volume the pyramid lets through is tested (an ablation).
+    bool useCostModel = true;
 };
 
 /// What the scheduler decided for a node reached during a frame (for the node-box view
@@ -118,6 +142,7 @@ enum class NodeState : std::uint8_t {
     VisibleNear,        ///< drawn without a query: camera inside or near plane crossed
     VisibleFront,       ///< drawn without a query: among the front-most frontPercent leaves
     VisibleVfc,         ///< vfc mode: in the frustum
+    VisibleCheaper,     ///< two-phase: drawn untested, since the cost model expects the test to cost more than it saves
 };
 const char* toString(NodeState s);
 
@@ -231,6 +256,21 @@ private:
         QueryVolume volume;  // world space, as the pyramid tested it
     };
     std::vector<TestedPart> candidates_, refresh_;
+    /// The cost model's measured rates of "occluded" answers, for parts new this frame and
+    /// for parts drawn early and tested again (moving averages over frames).
+    double candidateOccludedRate_ = 0.5, refreshOccludedRate_ = 0.5;
+    /// The drawing (ns) that the last frame with tests saved, and that frame's number.
+    double savedNs_ = 1e300;
+    std::uint32_t lastTestedFrame_ = 0;
+    std::uint64_t culledTriangles_ = 0;  // this frame, by the pyramid and the raster tests
+    /// Triangles under `ref`: its subtree's for an object node, its objects' for a scene node.
+    std::uint64_t subtreeTriangles(NodeRef ref);
+    std::vector<std::uint32_t> scratchIndices_;  // subtreeTriangles' stack
+    /// True if testing part `ref`, whose volume covers `rect`, is expected to save more
+    /// drawing than it costs, given that a fraction `occludedRate` of such tests cull.
+    bool worthTesting(NodeRef ref, const ScreenRect& rect, double occludedRate) const;
+    /// True for the new parts tested this frame whatever the cost model expects.
+    bool exploring(NodeRef ref) const;
     std::vector<QueryVolume> rasterVolumes_;
     std::vector<QueryResult> rasterAnswers_;
     /// One batched raster test of `parts`' volumes, answers in rasterAnswers_ (all Visible

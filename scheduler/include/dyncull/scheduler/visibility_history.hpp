@@ -49,6 +49,9 @@ public:
     /// hash of `ref`) so nodes that became visible together do not all re-query in the
     /// same later frame (which would make every k-th frame a spike of queries).
     bool canSkipQuery(NodeRef ref, const NodeHistory& h, std::uint32_t frame, const HistoryParams& p) const;
+    /// How many frames after its last answer a node known visible may go untested: what
+    /// its count of visible answers earns, shortened by the per-node jitter (0: test now).
+    std::uint32_t postponement(NodeRef ref, const NodeHistory& h, const HistoryParams& p) const;
 
     std::size_t memoryBytes() const;
 
