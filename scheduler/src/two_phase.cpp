@@ -9,8 +9,9 @@
 //     raster test against the early depth (NVIDIA's gl_occlusion_culling "temporal current
 //     frame" scheme) and the visible ones drawn; then the parts drawn are tested against
 //     the final depth, and those visible there are next frame's early set.
-// Which volumes are tested is CHC++'s question (Mattausch et al. 2008, sections 3-4: test
-// only where it pays, and visible nodes only every few frames): a cost model weighs a
+// Which volumes are tested is the question of NOHC (Guthe et al. 2006: a query's cost
+// against drawing's) and CHC++ (Mattausch et al. 2008: visible nodes only every few
+// frames; both in ../shared/notes/batched-occlusion-tests.md): a cost model weighs a
 // test's pixels against the part's triangles and the measured rate of tests that cull,
 // and a part drawn early is tested again only when its visibility history says so.
 // Conservative: whatever is not drawn was hidden behind depth that the final image also
