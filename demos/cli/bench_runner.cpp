@@ -39,26 +39,40 @@ std::vector<std::string> splitCommas(const std::string& s) {
     return out;
 }
 
-ModeSpec fullMode(const std::string& name) {
+ModeSpec queriesMode(const std::string& name) {
     ModeSpec m;
     m.name = name;
-    m.scheduler.mode = CullMode::Full;
+    m.scheduler.mode = CullMode::Queries;
     return m;
+}
+
+/// `full` and its ablations (two-phase), or false.
+bool applyTwoPhaseName(const std::string& part, ModeSpec& m) {
+    if (part != "full" && part != "full-hzb" && part != "full-nohist" && part != "full-nocost") return false;
+    m.scheduler.mode = CullMode::TwoPhase;
+    m.scheduler.useBatchedRaster = part != "full-hzb";
+    m.scheduler.useHistory = part != "full-nohist";
+    m.scheduler.useCostModel = part != "full-nocost";
+    return true;
 }
 
 }  // namespace
 
 std::string modeNamesHelp() {
-    return "vfc, simple, full, twophase (draw last frame's visible parts, test the rest against their depth pyramid, then what it cannot reject in one batched raster test), twophase-hzb (the pyramid alone), twophase-nohist (every part drawn early tested again each frame), twophase-nocost (every volume the pyramid lets through tested), oracle; approximate: thrN (pixel threshold), latency1 (last frame's results), "
+    return "vfc, simple, full (two-phase: draw last frame's visible parts, test the rest against their depth pyramid, then what it cannot reject in one batched raster test where that pays), "
+           "queries (hardware occlusion queries with history, batching and occupancy maps; the default before two-phase), oracle; "
+           "ablations of full: full-hzb (the pyramid alone), full-nohist (every part drawn early tested again each frame), full-nocost (every volume the pyramid lets through tested); "
+           "settings of queries: approximate thrN (pixel threshold), latency1 (last frame's results), "
            "skipN (history max skip N, 2 per visible), overlap (overlapping batches), smallN (small-feature pixels); "
            "backend: noflush (no glFlush after each batch); "
            "conservative: frontN (front-most N% of leaves drawn without queries); "
-           "ablations: full-nohist, full-nobatch, full-noocc, full-notight, full-nodrawq; order (waiting nodes hold back farther overlapping ones); settings of full combine with '+' "
-           "(thr16+latency1), including a query volume: aabb, obb, kdop14, kdop18, kdop26, auto (full+kdop26)";
+           "ablations: queries-nohist, queries-nobatch, queries-noocc, queries-notight, queries-nodrawq; order (waiting nodes hold back farther overlapping ones); settings of queries combine with '+' "
+           "(thr16+latency1); full, queries and their settings take a volume: aabb, obb, kdop14, kdop18, kdop26, auto (full+kdop26, thr16+obb)";
 }
 
 bool queriesNodeVolumes(const ModeSpec& m) {
-    return !m.oracle && m.scheduler.mode == CullMode::Full && m.scheduler.useTightVolumes;
+    return !m.oracle && (m.scheduler.mode == CullMode::Queries || m.scheduler.mode == CullMode::TwoPhase) &&
+           m.scheduler.useTightVolumes;
 }
 
 namespace {
@@ -115,25 +129,25 @@ Expected<std::vector<ModeSpec>> withVolumes(std::vector<ModeSpec> modes, const s
 
 namespace {
 
-/// Applies one setting of `full` (an approximate setting or an ablation) to `m`.
-bool applyFullSetting(const std::string& part, ModeSpec& m) {
+/// Applies one setting of `queries` (an approximate setting or an ablation) to `m`.
+bool applyQueriesSetting(const std::string& part, ModeSpec& m) {
     std::uint32_t n = 0;
-    if (part == "full") {
+    if (part == "queries") {
     } else if (part == "latency1") {
         m.scheduler.useLastFrameResults = true;
     } else if (part == "noflush") {
         m.queries.flushAfterBatch = false;
     } else if (part == "overlap") {
         m.scheduler.batchOverlapping = true;
-    } else if (part == "full-nohist") {
+    } else if (part == "queries-nohist") {
         m.scheduler.useHistory = false;
-    } else if (part == "full-nobatch") {
+    } else if (part == "queries-nobatch") {
         m.scheduler.useBatching = false;
-    } else if (part == "full-noocc") {
+    } else if (part == "queries-noocc") {
         m.scheduler.useOccupancyAccept = false;
-    } else if (part == "full-notight") {
+    } else if (part == "queries-notight") {
         m.scheduler.useTightVolumes = false;
-    } else if (part == "full-nodrawq") {
+    } else if (part == "queries-nodrawq") {
         m.scheduler.useDrawQueries = false;
     } else if (part == "order") {
         m.scheduler.useWaitOrder = true;
@@ -155,22 +169,18 @@ bool applyFullSetting(const std::string& part, ModeSpec& m) {
 }  // namespace
 
 Expected<ModeSpec> modeFromName(const std::string& name) {
-    ModeSpec m = fullMode(name);
+    ModeSpec m = queriesMode(name);
     if (name == "vfc") {
         m.scheduler.mode = CullMode::Vfc;
     } else if (name == "simple") {
         m.scheduler.mode = CullMode::Simple;
-    } else if (name == "twophase" || name == "twophase-hzb" || name == "twophase-nohist" || name == "twophase-nocost") {
-        m.scheduler.mode = CullMode::TwoPhase;
-        m.scheduler.useBatchedRaster = name != "twophase-hzb";
-        m.scheduler.useHistory = name != "twophase-nohist";
-        m.scheduler.useCostModel = name != "twophase-nocost";
     } else if (name == "oracle") {
         m.oracle = true;
     } else {
-        // Settings of `full` combine with '+', e.g. thr16+latency1; at most one is a volume.
+        // `full` or one of its ablations, or settings of `queries`, combined with '+'
+        // (thr16+latency1); at most one part is a volume.
         std::size_t start = 0;
-        bool volume = false;
+        bool volume = false, twoPhase = false, querySetting = false;
         while (true) {
             const std::size_t plus = name.find('+', start);
             const std::string part = name.substr(start, plus == std::string::npos ? std::string::npos : plus - start);
@@ -178,14 +188,21 @@ Expected<ModeSpec> modeFromName(const std::string& name) {
                 if (volume) return Error{"--modes: '" + name + "' names two volumes"};
                 volume = true;
                 m.scheduler.volume = *v;
-            } else if (!applyFullSetting(part, m)) {
+            } else if (!twoPhase && !querySetting && applyTwoPhaseName(part, m)) {
+                twoPhase = true;
+            } else if (!twoPhase && applyQueriesSetting(part, m)) {
+                querySetting = true;
+            } else if (twoPhase || (querySetting && applyTwoPhaseName(part, m))) {
+                return Error{"--modes: '" + name + "': '" + part + "' does not combine with " + (twoPhase ? "full" : "settings of queries") +
+                             " (full and its ablations take only a volume)"};
+            } else {
                 return Error{"--modes: unknown mode '" + part + "' in '" + name + "' (known: " + modeNamesHelp() + ")"};
             }
             if (plus == std::string::npos) break;
             start = plus + 1;
         }
         if (volume && !queriesNodeVolumes(m))
-            return Error{"--modes: '" + name + "': full-notight queries world boxes and takes no volume"};
+            return Error{"--modes: '" + name + "': queries-notight queries world boxes and takes no volume"};
     }
     if (Status s = validateSchedulerParams(m.scheduler); !s) return Error{"--modes: " + name + ": " + s.message()};
     return m;
@@ -217,7 +234,7 @@ Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec) {
     for (const std::string& text : splitCommas(spec.substr(eq + 1))) {
         std::uint32_t v = 0;
         if (!parseU32(text, v)) return Error{"--param " + param + ": '" + text + "' is not a non-negative integer"};
-        ModeSpec m = fullMode(param + "=" + text);
+        ModeSpec m = queriesMode(param + "=" + text);
         if (param == "pixel-threshold") {
             m.queries.visiblePixelThreshold = v;
         } else if (param == "max-skip") {

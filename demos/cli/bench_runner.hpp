@@ -31,17 +31,19 @@ struct ModeSpec {
     GlQueryParams queries;
 };
 
-/// A named mode: vfc, simple, full, oracle; approximate presets thrN (pixel threshold N),
-/// latency1 (last frame's results), skipN (history: max skip N, 2 frames per visible
-/// answer), overlap (overlapping batches), smallN (small-feature culling below N pixels);
-/// frontN (conservative: the front-most N% of frustum leaves drawn without queries);
-/// ablations full-nohist, full-nobatch, full-noocc, full-notight, full-nodrawq. Settings of full combine
-/// with '+' (thr16+latency1); one of them may be a query volume (aabb, obb, kdop14, kdop18,
-/// kdop26, auto: full+kdop26, thr16+obb) for modes that query node volumes
-/// (queriesNodeVolumes). Error names the mode.
+/// A named mode: vfc, simple, full (two-phase, the default), queries (hardware queries),
+/// oracle; ablations of full: full-hzb, full-nohist, full-nocost; settings of queries:
+/// approximate presets thrN (pixel threshold N), latency1 (last frame's results), skipN
+/// (history: max skip N, 2 frames per visible answer), overlap (overlapping batches),
+/// smallN (small-feature culling below N pixels); frontN (conservative: the front-most N%
+/// of frustum leaves drawn without queries); ablations queries-nohist, queries-nobatch,
+/// queries-noocc, queries-notight, queries-nodrawq. Settings of queries combine with '+'
+/// (thr16+latency1); one part may be a volume (aabb, obb, kdop14, kdop18, kdop26, auto:
+/// full+kdop26, thr16+obb) for modes that test node volumes (queriesNodeVolumes). Error
+/// names the mode.
 Expected<ModeSpec> modeFromName(const std::string& name);
-/// True for modes whose queries use the nodes' stored volumes (Full with tightened
-/// volumes, not the oracle), i.e. the modes a volume choice changes.
+/// True for modes whose tests use the nodes' stored volumes (queries and full with
+/// tightened volumes, not the oracle), i.e. the modes a volume choice changes.
 bool queriesNodeVolumes(const ModeSpec& m);
 /// `--volume`: every mode that queries node volumes, and whose name does not already name
 /// a volume, uses `volume` (names unchanged). Error for an unknown volume name.
@@ -55,9 +57,9 @@ Expected<std::vector<ModeSpec>> modesFromList(const std::string& list);
 /// Names understood by modeFromName (N stands for a number), for help texts.
 std::string modeNamesHelp();
 
-/// Sweep of one parameter of `full`: "NAME=v1,v2,..." with NAME one of pixel-threshold,
+/// Sweep of one parameter of `queries`: "NAME=v1,v2,..." with NAME one of pixel-threshold,
 /// max-skip, skip-per-visible, small-feature, max-in-flight, tile-size, auto-saving
-/// (percent; full with the auto volume). One mode per value, named "NAME=v". Error names
+/// (percent; queries with the auto volume). One mode per value, named "NAME=v". Error names
 /// the bad parameter or value.
 Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec);
 std::string sweepParamsHelp();

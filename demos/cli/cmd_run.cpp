@@ -67,7 +67,8 @@ void runRun(RunOptions o) {
     if (!size) fail(size.error().message);
     auto mode = parseCullMode(o.mode);
     if (!mode) fail("--mode: " + mode.error().message);
-    if (o.flags.volume != SchedulerFlags{}.volume && *mode != CullMode::Full) fail("--volume: applies to --mode full only");
+    if (o.flags.volume != SchedulerFlags{}.volume && *mode != CullMode::TwoPhase && *mode != CullMode::Queries)
+        fail("--volume: applies to --mode full and queries only");
     setCrashPhase("scene set-up");
     auto made = makeScene(o.scene, o.sceneOptions);
     if (!made) fail(made.error().message);
@@ -193,7 +194,7 @@ void registerRun(CLI::App& app) {
     auto o = std::make_shared<RunOptions>();
     CLI::App* cmd = app.add_subcommand("run", "Play a scene's camera path with one culling mode (headless by default)");
     cmd->add_option("scene", o->scene, "bunnies, powerplant, city, a directory of .ply/.obj parts, a .ply/.obj/.gltf/.glb file, or a .dsub file from dyncull subdivide")->capture_default_str();
-    cmd->add_option("--mode", o->mode, "vfc, simple, full or twophase")->capture_default_str();
+    cmd->add_option("--mode", o->mode, "vfc, simple, queries (hardware queries) or full (two-phase, the default)")->capture_default_str();
     cmd->add_option("--frames", o->frames, "frames to run (default: the scene's camera path once)")
         ->check(wholeIn(1, kMaxFrames));
     cmd->add_option("--size", o->size, "framebuffer size WxH")->capture_default_str();
@@ -203,7 +204,7 @@ void registerRun(CLI::App& app) {
     cmd->add_option("--shots", o->shots, "also write PNGs of these frames")
         ->check(wholeIn(0, kMaxFrames))
         ->delimiter(',');
-    cmd->add_flag("--window", o->window, "interactive GLFW window (fly, 1/2/3 modes, B node boxes; --frames limits it)");
+    cmd->add_flag("--window", o->window, "interactive GLFW window (fly, 1/2/3/4 modes, B node boxes; --frames limits it)");
     cmd->add_option("--shading", o->shading, "lighting per vertex (fast) or per pixel")
         ->transform(CLI::CheckedTransformer(std::map<std::string, Shading>{{"vertex", Shading::Vertex}, {"pixel", Shading::Pixel}}))
         ->default_str("vertex");

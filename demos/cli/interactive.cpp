@@ -30,7 +30,7 @@ InteractiveViewer::InteractiveViewer(Engine& engine, DemoScene& scene, const Int
     state_.useHistory = options.params.useHistory;
     state_.useOccupancy = options.params.useOccupancyAccept;
     state_.useTight = options.params.useTightVolumes;
-    for (CullMode m : {CullMode::Vfc, CullMode::Simple, CullMode::Full})
+    for (CullMode m : {CullMode::Vfc, CullMode::Simple, CullMode::Queries, CullMode::TwoPhase})
         schedulers_[static_cast<int>(m)] = std::make_unique<QueryScheduler>(paramsFor(m));
 }
 
@@ -48,7 +48,8 @@ void InteractiveViewer::applyKeys(const InputFrame& in) {
     const bool ablation = in.wasPressed(Key::H) || in.wasPressed(Key::O) || in.wasPressed(Key::T);
     if (in.wasPressed(Key::Num1)) state_.mode = CullMode::Vfc;
     if (in.wasPressed(Key::Num2)) state_.mode = CullMode::Simple;
-    if (in.wasPressed(Key::Num3)) state_.mode = CullMode::Full;
+    if (in.wasPressed(Key::Num3)) state_.mode = CullMode::TwoPhase;
+    if (in.wasPressed(Key::Num4)) state_.mode = CullMode::Queries;
     if (in.wasPressed(Key::B)) state_.boxes = !state_.boxes;
     if (in.wasPressed(Key::F)) state_.filter.frustumCulled = !state_.filter.frustumCulled;
     if (in.wasPressed(Key::I)) state_.filter.innerVisible = !state_.filter.innerVisible;
@@ -144,7 +145,7 @@ Status InteractiveViewer::step(const InputFrame& input, double dtSeconds) {
     state_.boxesDrawn = state_.boxes ? view_.drawBoxes(engine_, state_.filter) : 0;
     if (options_.text) {
         view_.drawText(engine_, statsLines(), state_.boxes,
-                       "1/2/3 vfc/simple/full  P path/fly  B boxes  F/I/L box filters  H/O/T ablation\n"
+                       "1/2/3/4 vfc/simple/full/queries  P path/fly  B boxes  F/I/L box filters  H/O/T ablation\n"
                        "WASD+QE fly  RMB or M look  Shift/Ctrl/+/- speed  Esc quit");
     }
     if (dtSeconds > 0.0) {

@@ -11,6 +11,7 @@
 // (switching back to full resumes with warm history instead of re-querying everything).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -61,7 +62,7 @@ private:
 };
 
 struct InteractiveOptions {
-    SchedulerParams params;       ///< starting mode and switches (shared by the three modes)
+    SchedulerParams params;       ///< starting mode and switches (shared by the modes)
     std::uint64_t maxFrames = 0;  ///< stop after this many frames (0: until Esc or the window closes)
     bool boxes = false;           ///< start with the node-box view on
     bool text = true;             ///< stats panel, legend and help
@@ -69,7 +70,7 @@ struct InteractiveOptions {
 
 /// What the viewer is doing; read after each step by tests and by the caller's summary.
 struct InteractiveState {
-    CullMode mode = CullMode::Full;
+    CullMode mode = CullMode::TwoPhase;
     bool followPath = true;
     bool boxes = false;
     bool mouseLook = false;          ///< M toggle (the right button also looks while held)
@@ -111,7 +112,7 @@ private:
     DemoScene& scene_;
     InteractiveOptions options_;
     InteractiveState state_;
-    std::unique_ptr<QueryScheduler> schedulers_[3];  // indexed by CullMode
+    std::array<std::unique_ptr<QueryScheduler>, kCullModeCount> schedulers_;  // indexed by CullMode
     NodeBoxView view_;
     float yaw_ = 0.0f, pitch_ = 0.0f;  // free-flight orientation, radians
     float baseSpeed_ = 1.0f;

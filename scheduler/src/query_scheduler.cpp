@@ -23,8 +23,8 @@ const char* toString(CullMode m) {
     switch (m) {
         case CullMode::Vfc: return "vfc";
         case CullMode::Simple: return "simple";
-        case CullMode::Full: return "full";
-        case CullMode::TwoPhase: return "twophase";
+        case CullMode::Queries: return "queries";
+        case CullMode::TwoPhase: return "full";
     }
     return "?";
 }
@@ -48,9 +48,9 @@ const char* toString(NodeState s) {
 Expected<CullMode> parseCullMode(const std::string& s) {
     if (s == "vfc") return CullMode::Vfc;
     if (s == "simple") return CullMode::Simple;
-    if (s == "full") return CullMode::Full;
-    if (s == "twophase") return CullMode::TwoPhase;
-    return Error{"unknown mode '" + s + "' (expected vfc, simple, full or twophase)"};
+    if (s == "queries") return CullMode::Queries;
+    if (s == "full") return CullMode::TwoPhase;
+    return Error{"unknown mode '" + s + "' (expected vfc, simple, queries or full)"};
 }
 
 Status validateSchedulerParams(const SchedulerParams& p) {
@@ -110,15 +110,15 @@ FrameStats QueryScheduler::cullFrame(const TwoLevelTree& tree, const Camera& cam
     frontBudget_ = frontLeavesSeen_ = 0;
     if (params_.mode != CullMode::Vfc && params_.frontPercent > 0.0f && !rootBox.empty())
         frontBudget_ = static_cast<std::uint32_t>(std::ceil(double(params_.frontPercent) / 100.0 * countFrustumLeaves()));
-    if (params_.mode != CullMode::Full) {
-        // Switched away from Full: its last draw queries will not be read.
+    if (params_.mode != CullMode::Queries) {
+        // Switched away from Queries: its last draw queries will not be read.
         for (const Pending& p : drawQueries_) backend.release(p.id);
         drawQueries_.clear();
     }
     switch (params_.mode) {
         case CullMode::Vfc: runVfc(); break;
         case CullMode::Simple: runSimple(); break;
-        case CullMode::Full: runFull(); break;
+        case CullMode::Queries: runQueries(); break;
         case CullMode::TwoPhase: runTwoPhase(); break;
     }
     st.traversalMs = std::max(0.0, msSince(t0) - st.waitMs - st.drawMs - st.queryMs - st.depthReadMs);
@@ -252,7 +252,7 @@ QueryScheduler::FirstTest QueryScheduler::firstVisibilityTest(NodeRef ref, const
         trace(ref, box, NodeState::VisibleFront);
         return FirstTest::Visible;
     }
-    if (params_.mode != CullMode::Full) return FirstTest::NeedQuery;
+    if (params_.mode != CullMode::Queries) return FirstTest::NeedQuery;
     if (params_.smallFeaturePixels > 0 && static_cast<std::uint32_t>(rect.area()) < params_.smallFeaturePixels) {
         ++st.smallFeatureCulled;
         h.lastVisible = false;
@@ -268,7 +268,7 @@ QueryScheduler::FirstTest QueryScheduler::firstVisibilityTest(NodeRef ref, const
 }
 
 QueryVolume QueryScheduler::queryVolume(NodeRef ref, const Aabb& worldBox) const {
-    if (ref.isSceneNode() || params_.mode != CullMode::Full || !params_.useTightVolumes) return QueryVolume::fromAabb(worldBox);
+    if (ref.isSceneNode() || params_.mode != CullMode::Queries || !params_.useTightVolumes) return QueryVolume::fromAabb(worldBox);
     // Tightened volume: the node's own object-space volume under the object's matrix
     // instead of its world AABB, once the object has kept its transform for a few frames.
     if (frame_ - stillSince_[ref.object] < params_.tightenAfterFrames) return QueryVolume::fromAabb(worldBox);
@@ -292,7 +292,7 @@ void QueryScheduler::drawNode(NodeRef ref, bool untested) {
     const SceneObjects& objs = tree_->objects();
     const LocalBspNode& n = objs.model(objs.modelOf(ref.object)).nodes[ref.node];
     const auto t0 = Clock::now();
-    if (untested && params_.mode == CullMode::Full && params_.useDrawQueries) {
+    if (untested && params_.mode == CullMode::Queries && params_.useDrawQueries) {
         const QueryId id = backend_->beginDrawQuery();
         sink_->drawPart(ref.object, n.firstIndex, n.indexCount);
         if (id != kNoQuery) {
@@ -306,7 +306,7 @@ void QueryScheduler::drawNode(NodeRef ref, bool untested) {
     stats_->drawMs += msSince(t0);
     ++stats_->partsDrawn;
     stats_->trianglesDrawn += n.indexCount / 3;
-    if (params_.mode == CullMode::Full && params_.useOccupancyAccept) {
+    if (params_.mode == CullMode::Queries && params_.useOccupancyAccept) {
         ScreenRect r;
         projectRect(tree_->worldBox(ref), r);
         drawnMap_.mark(r);
@@ -474,7 +474,7 @@ void QueryScheduler::collectDrawAnswers() {
     });
 }
 
-void QueryScheduler::runFull() {
+void QueryScheduler::runQueries() {
     // Algorithm 2 with batching: the active list (a stack, nearest at the back) is refined
     // as visible nodes are replaced by their children; nodes that need a query but overlap
     // a pending query's rectangle (or exceed the in-flight limit) wait in `deferred`.

@@ -157,7 +157,7 @@ void QueryScheduler::runTwoPhase() {
             for (auto it = scratch_.rbegin(); it != scratch_.rend(); ++it) active_.push_back(*it);
         } else if (drawnEarly) {
             if (!raster || certain) continue;
-            // Visibility history, as in Full: a part that kept answering "visible" is
+            // Visibility history, as in Queries: a part that kept answering "visible" is
             // tested again only after the frames its answers earn. The cost model may
             // postpone it further, but not past history's longest postponement, so every
             // part is tested now and then and the rate of culling tests stays measured.

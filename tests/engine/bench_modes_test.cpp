@@ -12,9 +12,28 @@ TEST(BenchModes, BaseModes) {
     EXPECT_EQ(modeFromName("simple")->scheduler.mode, CullMode::Simple);
     EXPECT_TRUE(modeFromName("oracle")->oracle);
     const ModeSpec full = modeFromName("full").take();
-    EXPECT_EQ(full.scheduler.mode, CullMode::Full);
-    EXPECT_EQ(full.queries.visiblePixelThreshold, 0u);  // conservative by default
-    EXPECT_FALSE(full.scheduler.useLastFrameResults);
+    EXPECT_EQ(full.scheduler.mode, CullMode::TwoPhase);
+    EXPECT_TRUE(full.scheduler.useBatchedRaster && full.scheduler.useCostModel && full.scheduler.useHistory);
+    EXPECT_EQ(full.scheduler.mode, SchedulerParams{}.mode) << "full is the library's default";
+    const ModeSpec queries = modeFromName("queries").take();
+    EXPECT_EQ(queries.scheduler.mode, CullMode::Queries);
+    EXPECT_EQ(queries.queries.visiblePixelThreshold, 0u);  // conservative by default
+    EXPECT_FALSE(queries.scheduler.useLastFrameResults);
+}
+
+TEST(BenchModes, AblationsOfFullAndTheirVolumes) {
+    EXPECT_FALSE(modeFromName("full-hzb")->scheduler.useBatchedRaster);
+    EXPECT_FALSE(modeFromName("full-nohist")->scheduler.useHistory);
+    EXPECT_FALSE(modeFromName("full-nocost")->scheduler.useCostModel);
+    const ModeSpec k = modeFromName("full+kdop26").take();
+    EXPECT_EQ(k.scheduler.mode, CullMode::TwoPhase);
+    EXPECT_EQ(k.scheduler.volume, VolumeChoice::Kdop26);
+    // Settings of queries do not combine with full, either way round.
+    for (const char* bad : {"full+thr16", "thr16+full", "full+full-hzb"}) {
+        auto m = modeFromName(bad);
+        ASSERT_FALSE(m) << bad;
+        EXPECT_NE(m.error().message.find("does not combine"), std::string::npos) << m.error().message;
+    }
 }
 
 TEST(BenchModes, PresetsSetOneThing) {
@@ -22,14 +41,14 @@ TEST(BenchModes, PresetsSetOneThing) {
     EXPECT_EQ(modeFromName("small4")->scheduler.smallFeaturePixels, 4u);
     EXPECT_TRUE(modeFromName("latency1")->scheduler.useLastFrameResults);
     EXPECT_TRUE(modeFromName("overlap")->scheduler.batchOverlapping);
-    EXPECT_FALSE(modeFromName("full-nohist")->scheduler.useHistory);
+    EXPECT_FALSE(modeFromName("queries-nohist")->scheduler.useHistory);
     EXPECT_EQ(modeFromName("skip20")->scheduler.history.maxSkipFrames, 20u);
 }
 
 TEST(BenchModes, SettingsCombineWithPlus) {
-    const ModeSpec m = modeFromName("thr16+latency1+full-noocc").take();
-    EXPECT_EQ(m.name, "thr16+latency1+full-noocc");
-    EXPECT_EQ(m.scheduler.mode, CullMode::Full);
+    const ModeSpec m = modeFromName("thr16+latency1+queries-noocc").take();
+    EXPECT_EQ(m.name, "thr16+latency1+queries-noocc");
+    EXPECT_EQ(m.scheduler.mode, CullMode::Queries);
     EXPECT_EQ(m.queries.visiblePixelThreshold, 16u);
     EXPECT_TRUE(m.scheduler.useLastFrameResults);
     EXPECT_FALSE(m.scheduler.useOccupancyAccept);

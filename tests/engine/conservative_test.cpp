@@ -1,10 +1,10 @@
 // The key correctness test of the culling modes: on a small moving swarm (a bumpy
 // procedural blob written as a PLY, so no data files are needed), every conservative mode
-// — simple, full, each ablation of full and twophase — draws the same image as vfc (at most 0.01%
+// — simple, full (two-phase), queries, and each ablation of both — draws the same image as vfc (at most 0.01%
 // of pixels differ) with no visible part missing against the ID-pass ground truth and no
 // stalled query, on every frame. The oracle draws exactly the visible set and must match
 // too; a large pixel threshold must show up as false negatives (the measurement sees errors).
-// The same holds for full with every query volume (AABB, PCA box, 14/18/26-DOP, auto).
+// The same holds for queries with every query volume (AABB, PCA box, 14/18/26-DOP, auto).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -94,7 +94,7 @@ protected:
 TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
     ASSERT_NO_FATAL_FAILURE(build("dyncull_conservative_", 30));
 
-    const char* conservative = "vfc,simple,full,full-nohist,full-nobatch,full-noocc,full-notight,full-nodrawq,order,front10,twophase,twophase-hzb,oracle,thr64";
+    const char* conservative = "vfc,simple,full,full-hzb,full-nohist,full-nocost,queries,queries-nohist,queries-nobatch,queries-noocc,queries-notight,queries-nodrawq,order,front10,oracle,thr64";
     auto modes = cli::modesFromList(conservative);
     ASSERT_TRUE(modes.ok()) << modes.error().message;
     // The test checks culling, not latency: a query that outlasts the default 250 ms bound
@@ -108,7 +108,7 @@ TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
     ASSERT_EQ(names[0].name, "vfc");
 
     std::uint64_t visibleSeen = 0, thresholdMisses = 0, occludedSeen = 0, queries = 0, drawQueriesOccluded = 0, boundSlack = 0;
-    std::uint64_t rasterTests = 0, rasterParts = 0, pyramidParts = 0;  // twophase with and without the batched raster test
+    std::uint64_t rasterTests = 0, rasterParts = 0, pyramidParts = 0;  // full with and without the batched raster test
     double worstPercent = 0.0;
     for (std::uint64_t frame = 0; frame < bo.frames; ++frame) {
         ASSERT_TRUE((*runner)->runFrame(frame).ok());
@@ -136,9 +136,9 @@ TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
             SCOPED_TRACE(names[m].name + " frame " + std::to_string(frame));
             worstPercent = std::max(worstPercent, row[m].image.percentDiffering);
             queries += row[m].stats.queriesIssued;
-            if (names[m].name == "full") drawQueriesOccluded += row[m].stats.drawQueriesOccluded;
-            if (names[m].name == "twophase") rasterTests += row[m].stats.rasterTests, rasterParts += row[m].stats.partsDrawn;
-            if (names[m].name == "twophase-hzb") {
+            if (names[m].name == "queries") drawQueriesOccluded += row[m].stats.drawQueriesOccluded;
+            if (names[m].name == "full") rasterTests += row[m].stats.rasterTests, rasterParts += row[m].stats.partsDrawn;
+            if (names[m].name == "full-hzb") {
                 pyramidParts += row[m].stats.partsDrawn;
                 EXPECT_EQ(row[m].stats.rasterTests, 0u);
             }
@@ -168,7 +168,7 @@ TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
 
 TEST(Conservative, SubdividedStaticModelsDrawTheVfcImage) {
     // A static model cut into objects by each method (issue 8), on the fly and through a
-    // subdivision file: full and front-most-10% draw the vfc image with nothing missing.
+    // subdivision file: full, queries and front-most-10% draw the vfc image with nothing missing.
     const fs::path dir = fs::temp_directory_path() / ("dyncull_subdivided_" + std::to_string(::getpid()));
     fs::create_directories(dir);
     const fs::path ply = dir / "blob.ply";
@@ -194,7 +194,7 @@ TEST(Conservative, SubdividedStaticModelsDrawTheVfcImage) {
             ASSERT_TRUE((*scene)->populate(engine).ok());
             EXPECT_EQ(engine.objects().objectCount(), saved->subdivision.stats.leaves);
             EXPECT_GE(saved->subdivision.stats.leaves, 9216u / 500u);
-            auto modes = cli::modesFromList("vfc,full,front10,twophase");
+            auto modes = cli::modesFromList("vfc,full,queries,front10");
             ASSERT_TRUE(modes.ok());
             auto runner = cli::BenchRunner::create(engine, **scene, modes.take());
             ASSERT_TRUE(runner.ok()) << runner.error().message;
@@ -214,7 +214,7 @@ TEST(Conservative, SubdividedStaticModelsDrawTheVfcImage) {
 TEST_F(ConservativeSwarm, EveryQueryVolumeDrawsTheVfcImage) {
     ASSERT_NO_FATAL_FAILURE(build("dyncull_conservative_volumes_", 24));
 
-    auto modes = cli::modesFromList("vfc,full");
+    auto modes = cli::modesFromList("vfc,queries");
     ASSERT_TRUE(modes.ok());
     auto expanded = cli::withVolumes(modes.take(), "aabb,obb,kdop14,kdop18,kdop26,auto");
     ASSERT_TRUE(expanded.ok()) << expanded.error().message;
@@ -246,8 +246,8 @@ TEST_F(ConservativeSwarm, EveryQueryVolumeDrawsTheVfcImage) {
     // Tighter volumes are smaller (Table 5) and cull at least as well here; otherwise the
     // test would not exercise them.
     const std::size_t aabb = 1, kdop26 = 5;
-    ASSERT_EQ(names[aabb].name, "full+aabb");
-    ASSERT_EQ(names[kdop26].name, "full+kdop26");
+    ASSERT_EQ(names[aabb].name, "queries+aabb");
+    ASSERT_EQ(names[kdop26].name, "queries+kdop26");
     EXPECT_LT(totals[kdop26].surfaceArea, totals[aabb].surfaceArea);
     EXPECT_LT(totals[kdop26].volume, totals[aabb].volume);
     EXPECT_LE(drawn[kdop26], drawn[aabb]);

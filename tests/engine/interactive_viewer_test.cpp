@@ -59,6 +59,7 @@ TEST(InteractiveViewer, ScriptedKeysSwitchModesBoxesAndCamera) {
 
         ScriptedInput input;
         input.pressAt(1, Key::Num2);  // simple
+        input.pressAt(2, Key::Num4);  // queries
         input.pressAt(3, Key::Num3);  // full
         input.pressAt(4, Key::B);     // boxes on
         input.pressAt(5, Key::H);     // history off
@@ -72,7 +73,7 @@ TEST(InteractiveViewer, ScriptedKeysSwitchModesBoxesAndCamera) {
         ASSERT_TRUE(n.ok()) << n.error().message;
         EXPECT_EQ(*n, 12u);
         EXPECT_EQ(st.framesRendered, 12u);
-        EXPECT_EQ(st.mode, CullMode::Full);
+        EXPECT_EQ(st.mode, CullMode::TwoPhase);
         EXPECT_TRUE(st.boxes);
         EXPECT_GT(st.boxesDrawn, 0u);
         EXPECT_FALSE(st.useHistory);
@@ -95,21 +96,25 @@ TEST(InteractiveViewer, ViewerStepsOneFrameAtATimeAndEscapeQuits) {
         TinyScene scene;
         ASSERT_TRUE(scene.populate(**engine).ok());
         InteractiveViewer viewer(**engine, scene, InteractiveOptions{});
-        EXPECT_EQ(viewer.state().mode, CullMode::Full);
+        EXPECT_EQ(viewer.state().mode, CullMode::TwoPhase);  // full, the default
         ASSERT_TRUE(viewer.step(InputFrame{}, 0.016).ok());
         EXPECT_EQ(viewer.state().framesRendered, 1u);
+        InputFrame four;
+        four.press(Key::Num4);
+        ASSERT_TRUE(viewer.step(four, 0.016).ok());
+        EXPECT_EQ(viewer.state().mode, CullMode::Queries);
         EXPECT_GT(viewer.baseSpeed(), 0.0f);
         InputFrame one;
         one.press(Key::Num1);
         ASSERT_TRUE(viewer.step(one, 0.016).ok());
         EXPECT_EQ(viewer.state().mode, CullMode::Vfc);
         EXPECT_EQ(viewer.state().last.queriesIssued, 0u);  // vfc issues no queries
-        EXPECT_EQ(viewer.state().framesRendered, 2u);
+        EXPECT_EQ(viewer.state().framesRendered, 3u);
         InputFrame esc;
         esc.press(Key::Escape);
         ASSERT_TRUE(viewer.step(esc, 0.016).ok());
         EXPECT_TRUE(viewer.state().quit);
-        EXPECT_EQ(viewer.state().framesRendered, 2u);  // quitting renders nothing more
+        EXPECT_EQ(viewer.state().framesRendered, 3u);  // quitting renders nothing more
     }
     EXPECT_EQ(ctx->checkErrors(), 0u);
 }

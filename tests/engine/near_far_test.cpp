@@ -161,7 +161,7 @@ TEST(NearFar, NearPlane1eMinus4WithFarPlane1e7MatchesTheLayeredReference) {
     const VisibleSet truth = scene.rig.truth->compute(*scene.rig.engine, camera(kNear, kFar));
 
     auto vfcVsRef = compareImages(ref.image, r.vfcImage);
-    auto fullImgVsRef = compareImages(ref.image, r.fullImage);
+    auto fullImgVsRef = compareImages(ref.image, r.queriesImage);
     ASSERT_TRUE(vfcVsRef.ok() && fullImgVsRef.ok());
     const PartErrors truthVsRef = compareParts(ref.visible, truth.parts);
     const PartErrors fullPartsVsRef = compareParts(ref.visible, scene.rig.recorder.drawn());
@@ -173,14 +173,14 @@ TEST(NearFar, NearPlane1eMinus4WithFarPlane1e7MatchesTheLayeredReference) {
             ++hiddenObjects;
             hiddenDrawn += drawnObjects.count(p.handle.index) ? 1u : 0u;
         }
-    std::printf("near 1e-4 far 1e7: vfc differs from the layered reference in %.4f%% of pixels (%llu), full in "
-                "%.4f%%; ID pass sees %zu parts, reference %zu (%u missing, %u extra); full misses %u visible parts "
-                "of the reference, full/vfc parts drawn %u/%u, hidden objects drawn by full %u of %u, queries "
+    std::printf("near 1e-4 far 1e7: vfc differs from the layered reference in %.4f%% of pixels (%llu), queries in "
+                "%.4f%%; ID pass sees %zu parts, reference %zu (%u missing, %u extra); queries misses %u visible parts "
+                "of the reference, queries/vfc parts drawn %u/%u, hidden objects drawn by queries %u of %u, queries "
                 "occluded %u\n",
                 vfcVsRef->percentDiffering, static_cast<unsigned long long>(vfcVsRef->differingPixels),
                 fullImgVsRef->percentDiffering, truth.parts.size(), ref.visible.parts.size(), truthVsRef.falseNegatives,
-                truthVsRef.falsePositives, fullPartsVsRef.falseNegatives, r.fullStats.partsDrawn, r.vfcStats.partsDrawn,
-                hiddenDrawn, hiddenObjects, r.fullStats.queriesOccluded);
+                truthVsRef.falsePositives, fullPartsVsRef.falseNegatives, r.queriesStats.partsDrawn, r.vfcStats.partsDrawn,
+                hiddenDrawn, hiddenObjects, r.queriesStats.queriesOccluded);
 
     // The scene is what it claims: every object not hidden by construction shows, no hidden one does.
     std::set<std::uint32_t> refObjects;
@@ -197,6 +197,19 @@ TEST(NearFar, NearPlane1eMinus4WithFarPlane1e7MatchesTheLayeredReference) {
     EXPECT_EQ(truth.artefactPixels, 0u);  // every ID-pass fragment lies in its box's reversed-Z depth range
     EXPECT_EQ(fullPartsVsRef.falseNegatives, 0u);
     EXPECT_EQ(hiddenDrawn, 0u);
+    EXPECT_LT(r.queriesStats.partsDrawn, r.vfcStats.partsDrawn);
+
+    // full (two-phase): its depth pyramid and raster tests are as exact at these ranges.
+    auto twoPhaseVsRef = compareImages(ref.image, r.fullImage);
+    ASSERT_TRUE(twoPhaseVsRef.ok());
+    EXPECT_LE(twoPhaseVsRef->percentDiffering, 0.01);
+    EXPECT_EQ(compareParts(ref.visible, r.fullDrawn).falseNegatives, 0u);
+    std::set<std::uint32_t> twoPhaseObjects;
+    for (const PartKey& k : r.fullDrawn) twoPhaseObjects.insert(k.object);
+    for (const auto& p : scene.placed)
+        if (p.hidden) {
+            EXPECT_EQ(twoPhaseObjects.count(p.handle.index), 0u) << "full drew hidden " << p.what;
+        }
     EXPECT_LT(r.fullStats.partsDrawn, r.vfcStats.partsDrawn);
 }
 

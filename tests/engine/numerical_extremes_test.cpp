@@ -73,7 +73,7 @@ TEST(Extremes, NonFiniteTransformsAndCamerasAreRejectedAndTheOldStateStays) {
     // The scene still renders after all the rejected calls.
     const auto r = rig.frame(look({0, 0, 5}, {0, 0, 0}));
     expectConservative(r, "after rejections");
-    EXPECT_GT(nonBackground(r.fullImage), 100u);
+    EXPECT_GT(nonBackground(r.queriesImage), 100u);
 }
 
 // ---- Degenerate meshes -------------------------------------------------------------
@@ -128,10 +128,10 @@ TEST(Extremes, OneMillionTriangleObject) {
     rig.object(rig.model(test::cubeMesh(0.6f)), {0.5f, 0, 1.8f});
     const auto r = rig.frame(look({0, 0, 4}, {0, 0, 0}));
     expectConservative(r, "1M triangles");
-    EXPECT_GT(r.fullStats.queriesOccluded, 0u);  // the hidden back half was culled by queries
+    EXPECT_GT(r.queriesStats.queriesOccluded, 0u);  // the hidden back half was culled by queries
     std::printf("1M-triangle sphere: local BSP %u leaves, %zu triangles after splitting, built in %.0f ms; "
                 "full drew %u of %u parts\n",
-                bsp.stats.leaves, bsp.stats.trianglesAfter, buildMs, r.fullStats.partsDrawn, r.vfcStats.partsDrawn);
+                bsp.stats.leaves, bsp.stats.trianglesAfter, buildMs, r.queriesStats.partsDrawn, r.vfcStats.partsDrawn);
 }
 
 // ---- Scale and position ------------------------------------------------------------
@@ -149,7 +149,7 @@ TEST(Extremes, ObjectsScaledByOneMillionthAndOneMillion) {
         rig.object(sphere, glm::vec3(1.5f, 0, 0) * scale, glm::vec3(scale));
         const auto r = rig.frame(look(glm::vec3(0, 0.5f, 5) * scale, glm::vec3(0), 0.05f * scale, 100.0f * scale));
         expectConservative(r, "scale " + std::to_string(scale));
-        EXPECT_GT(r.fullStats.queriesOccluded + r.fullStats.skippedByOccupancy, 0u);
+        EXPECT_GT(r.queriesStats.queriesOccluded + r.queriesStats.skippedByOccupancy, 0u);
         if (scale == 1.0f) {
             reference = r.vfcImage;
             continue;
@@ -174,8 +174,8 @@ TEST(Extremes, CameraInsideAnObjectBoxAndInsideALocalBspNode) {
     for (const glm::vec3& eye : {glm::vec3(0, 0, 0), glm::vec3(0, 0, 4.6f), glm::vec3(3.2f, 3.2f, 0)}) {
         const auto r = rig.frame(look(eye, eye + glm::vec3(0, 0, -1)));
         expectConservative(r, "camera inside");
-        EXPECT_GT(r.fullStats.visibleNearOrInside, 1u);  // the object box and at least one node
-        EXPECT_GT(nonBackground(r.fullImage), static_cast<std::uint64_t>(kWidth * kHeight / 2));
+        EXPECT_GT(r.queriesStats.visibleNearOrInside, 1u);  // the object box and at least one node
+        EXPECT_GT(nonBackground(r.queriesImage), static_cast<std::uint64_t>(kWidth * kHeight / 2));
     }
 }
 
@@ -192,7 +192,7 @@ TEST(Extremes, BoxesStraddlingTheNearPlane) {
     for (float nearPlane : {0.4f, 0.55f, 0.9f}) {
         const auto r = rig.frame(look({0, 0, 0.8f}, {0, 0, -1}, nearPlane));
         expectConservative(r, "near " + std::to_string(nearPlane));
-        EXPECT_GT(r.fullStats.visibleNearOrInside, 0u);
+        EXPECT_GT(r.queriesStats.visibleNearOrInside, 0u);
     }
 }
 

@@ -70,6 +70,13 @@ Camera frontCamera() {
     return c;
 }
 
+/// The hardware-query mode these tests exercise (the library's default is two-phase).
+SchedulerParams queriesParams() {
+    SchedulerParams p;
+    p.mode = CullMode::Queries;
+    return p;
+}
+
 struct RecordingSink final : PartSink {
     std::multiset<std::uint32_t> drawn;
     void drawPart(std::uint32_t object, std::uint32_t, std::uint32_t) override { drawn.insert(object); }
@@ -140,11 +147,11 @@ TEST(QueryScheduler, AllVisibleDrawsExactlyWhatVfcDraws) {
     const auto reference = vfcDrawn(s);
     EXPECT_FALSE(reference.empty());
 
-    for (CullMode mode : {CullMode::Simple, CullMode::Full}) {
+    for (CullMode mode : {CullMode::Simple, CullMode::Queries}) {
         for (int latency : {0, 3}) {
             ScriptedBackend b;
             b.latency = latency;
-            SchedulerParams p;
+            SchedulerParams p = queriesParams();
             p.mode = mode;
             p.useOccupancyAccept = false;  // force queries
             FrameStats st;
@@ -162,7 +169,7 @@ TEST(QueryScheduler, QueriesThatNeverAnswerCountAsVisibleAndTheFrameEnds) {
     const auto reference = vfcDrawn(s);
     ScriptedBackend b;
     b.neverAnswer = true;
-    SchedulerParams p;
+    SchedulerParams p = queriesParams();
     p.useOccupancyAccept = false;
     p.queryTimeoutMs = 1.0;
     FrameStats st;
@@ -182,8 +189,8 @@ TEST(QueryScheduler, OccludedAnswersCullButNeverNearOrInsideBoxes) {
     s.bsp.update(s.objects);
     ScriptedBackend b;
     b.rule = [](const QueryVolume&) { return QueryResult::Occluded; };
-    for (CullMode mode : {CullMode::Simple, CullMode::Full}) {
-        SchedulerParams p;
+    for (CullMode mode : {CullMode::Simple, CullMode::Queries}) {
+        SchedulerParams p = queriesParams();
         p.mode = mode;
         p.useOccupancyAccept = false;
         FrameStats st;
@@ -197,7 +204,7 @@ TEST(QueryScheduler, OccludedAnswersCullButNeverNearOrInsideBoxes) {
 TEST(QueryScheduler, OccupancyAcceptNeedsNoQueryOnAnEmptyScreen) {
     TestScene s(1, 1);
     ScriptedBackend b;
-    SchedulerParams p;
+    SchedulerParams p = queriesParams();
     FrameStats st;
     const auto drawn = drawnWith(s, p, b, &st);
     EXPECT_EQ(drawn.size(), 1u);
@@ -208,7 +215,7 @@ TEST(QueryScheduler, OccupancyAcceptNeedsNoQueryOnAnEmptyScreen) {
 TEST(QueryScheduler, HistorySkipsQueriesForNodesVisibleRecently) {
     TestScene s(5, 4);
     ScriptedBackend b;
-    SchedulerParams p;
+    SchedulerParams p = queriesParams();
     p.useOccupancyAccept = false;
     QueryScheduler sched(p);
     TwoLevelTree tree(s.bsp, s.objects);
@@ -238,7 +245,7 @@ TEST(QueryScheduler, OccludedNodesAreQueriedAgainEveryFrame) {
     TestScene s(3, 3);
     ScriptedBackend b;
     b.rule = [](const QueryVolume&) { return QueryResult::Occluded; };
-    SchedulerParams p;
+    SchedulerParams p = queriesParams();
     p.useOccupancyAccept = false;
     QueryScheduler sched(p);
     TwoLevelTree tree(s.bsp, s.objects);
@@ -256,7 +263,7 @@ TEST(QueryScheduler, BatchesHoldOnlyNonOverlappingRectangles) {
     TestScene s(6, 6);
     ScriptedBackend b;
     b.latency = 2;
-    SchedulerParams p;
+    SchedulerParams p = queriesParams();
     p.useOccupancyAccept = false;
     p.occupancyTileSize = 8;
     const Camera cam = frontCamera();
@@ -304,7 +311,7 @@ TEST(QueryScheduler, WithWaitOrderAFartherNodeNeverOvertakesAWaitingNearerNodeIt
     bsp.build(objects);
     ScriptedBackend b;
     b.latency = 2;
-    SchedulerParams p;
+    SchedulerParams p = queriesParams();
     p.useOccupancyAccept = false;  // an empty screen would accept everything
     p.occupancyTileSize = 8;
     p.useWaitOrder = true;
@@ -327,7 +334,7 @@ TEST(QueryScheduler, WithWaitOrderAFartherNodeNeverOvertakesAWaitingNearerNodeIt
 }
 
 TEST(QueryScheduler, ParamsAreValidated) {
-    SchedulerParams p;
+    SchedulerParams p = queriesParams();
     EXPECT_TRUE(validateSchedulerParams(p).ok());
     p.maxQueriesInFlight = 0;
     EXPECT_FALSE(validateSchedulerParams(p).ok());
@@ -335,7 +342,10 @@ TEST(QueryScheduler, ParamsAreValidated) {
     p.occupancyTileSize = 0;
     EXPECT_FALSE(validateSchedulerParams(p).ok());
     EXPECT_FALSE(parseCullMode("fast").ok());
-    EXPECT_EQ(parseCullMode("full").value(), CullMode::Full);
+    EXPECT_EQ(parseCullMode("full").value(), CullMode::TwoPhase);
+    EXPECT_EQ(parseCullMode("queries").value(), CullMode::Queries);
+    for (CullMode m : {CullMode::Vfc, CullMode::Simple, CullMode::Queries, CullMode::TwoPhase})
+        EXPECT_EQ(parseCullMode(toString(m)).value(), m);
 }
 
 // Which of `cubes` (front-face distances from the eye along -Z, cube half size `half`)
@@ -362,7 +372,7 @@ std::vector<bool> drawnWhenAllOccluded(const glm::vec3& eye, float nearPlane, fl
     c.aspect = 2.0f;
     ScriptedBackend b;
     b.rule = [](const QueryVolume&) { return QueryResult::Occluded; };
-    SchedulerParams p;
+    SchedulerParams p = queriesParams();
     p.useOccupancyAccept = false;
     QueryScheduler sched(p);
     RecordingSink sink;
@@ -413,11 +423,11 @@ TEST(QueryScheduler, FrontMostLeavesAreDrawnWithoutQueries) {
             nearest = o;
         }
     }
-    for (CullMode mode : {CullMode::Simple, CullMode::Full}) {
+    for (CullMode mode : {CullMode::Simple, CullMode::Queries}) {
         for (float percent : {10.0f, 50.0f, 100.0f}) {
             ScriptedBackend b;
             b.rule = [](const QueryVolume&) { return QueryResult::Occluded; };
-            SchedulerParams p;
+            SchedulerParams p = queriesParams();
             p.mode = mode;
             p.useOccupancyAccept = false;
             p.frontPercent = percent;
@@ -478,7 +488,7 @@ TEST(QueryScheduler, ObjectNodesAreQueriedWithTheChosenVolume) {
                            VolumeChoice::Kdop26, VolumeChoice::Auto}) {
         SCOPED_TRACE(toString(c));
         ScriptedBackend b;
-        SchedulerParams p;
+        SchedulerParams p = queriesParams();
         p.useOccupancyAccept = false;  // force queries
         p.useHistory = false;
         p.volume = c;
@@ -501,8 +511,8 @@ TEST(QueryScheduler, ObjectNodesAreQueriedWithTheChosenVolume) {
     // Simple and the untightened ablation query world boxes only.
     for (bool simple : {true, false}) {
         ScriptedBackend b;
-        SchedulerParams p;
-        p.mode = simple ? CullMode::Simple : CullMode::Full;
+        SchedulerParams p = queriesParams();
+        p.mode = simple ? CullMode::Simple : CullMode::Queries;
         p.useTightVolumes = simple;
         p.useOccupancyAccept = false;
         p.volume = VolumeChoice::Kdop26;
@@ -629,7 +639,7 @@ TEST(QueryScheduler, DrawQueriesKeepVisiblePartsUnqueriedAndRequeryPartsThatDrew
     for (bool drawQueries : {true, false}) {
         SCOPED_TRACE(drawQueries ? "draw queries" : "history only");
         DrawQueryBackend b;
-        SchedulerParams p;
+        SchedulerParams p = queriesParams();
         p.useOccupancyAccept = false;  // every part needs a query or history
         p.history.jitter = false;
         p.useDrawQueries = drawQueries;
@@ -719,7 +729,7 @@ TEST(QueryFaults, HungQueriesInTheWaitPathCountVisibleWithinTheBound) {
     TestScene s(4, 3);
     const auto reference = vfcDrawn(s);
     HungBackend b;
-    SchedulerParams p;
+    SchedulerParams p = queriesParams();
     p.mode = CullMode::Simple;
     p.queryTimeoutMs = 2.0;
     QueryScheduler sched(p);
@@ -745,8 +755,8 @@ TEST(QueryFaults, HungQueriesInTheNonBlockingPathCountVisibleWithinTheBound) {
     TestScene s(5, 4);
     const auto reference = vfcDrawn(s);
     HungBackend b;
-    SchedulerParams p;
-    p.mode = CullMode::Full;
+    SchedulerParams p = queriesParams();
+    p.mode = CullMode::Queries;
     p.useOccupancyAccept = false;  // force queries
     p.useHistory = false;
     p.maxQueriesInFlight = 3;
@@ -774,7 +784,7 @@ TEST(QueryFaults, HungQueriesWithLastFrameResultsNeverCullAndNeverPileUp) {
     TestScene s(4, 3);
     const auto reference = vfcDrawn(s);
     HungBackend b;
-    SchedulerParams p;
+    SchedulerParams p = queriesParams();
     p.useOccupancyAccept = false;
     p.useHistory = false;
     p.useLastFrameResults = true;
@@ -838,7 +848,7 @@ TEST(QueryFaults, AnswersForARemovedObjectAreDroppedWhenItsSlotIsReused) {
         const glm::vec3 e = hi - lo;
         return std::max({e.x, e.y, e.z}) < 0.65f ? QueryResult::Occluded : QueryResult::Visible;
     };
-    SchedulerParams p;
+    SchedulerParams p = queriesParams();
     p.useLastFrameResults = true;
     p.useHistory = false;
     p.useOccupancyAccept = false;

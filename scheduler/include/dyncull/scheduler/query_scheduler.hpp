@@ -22,21 +22,29 @@
 
 namespace dyncull {
 
+/// The culling modes; the CLI names them by toString (parseCullMode reads them back).
 enum class CullMode : std::uint8_t {
-    Vfc,     ///< frustum culling only
-    Simple,  ///< the paper's Simple OC: one stop-and-wait query per node in the frustum
-    Full,    ///< everything below, each feature switchable for ablation
-    /// Two-phase method of GPU-driven engines: draw last frame's visible parts, read the
-    /// depth back into a farthest-depth pyramid, test every node against it on the CPU,
-    /// draw what is newly visible (QueryBackend::readDepth; without it nothing is culled).
+    Vfc,     ///< `vfc`: frustum culling only
+    Simple,  ///< `simple`: the paper's Simple OC, one stop-and-wait query per node in the frustum
+    /// `queries`: hardware occlusion queries scheduled as in the two-level paper, with
+    /// visibility history, batching, occupancy maps, tight volumes and draw queries, each
+    /// switchable for ablation; the approximate settings apply to it. It was `full` until
+    /// TwoPhase culled more for less on every bundled scene (docs/BENCHMARKS.md).
+    Queries,
+    /// `full`, the default conservative mode: the two-phase method of GPU-driven engines.
+    /// Draw last frame's visible parts, read the depth back into a farthest-depth pyramid,
+    /// test every node against it on the CPU, test what it cannot reject in one batched
+    /// raster test, draw what is newly visible (QueryBackend::readDepth and testVolumes;
+    /// without them nothing is culled).
     TwoPhase,
 };
+inline constexpr int kCullModeCount = 4;
 const char* toString(CullMode m);
 Expected<CullMode> parseCullMode(const std::string& s);
 
 struct SchedulerParams {
-    CullMode mode = CullMode::Full;
-    // Ablation switches for Full.
+    CullMode mode = CullMode::TwoPhase;
+    // Ablation switches: useHistory for Queries and TwoPhase, the next three for Queries.
     bool useHistory = true;
     bool useBatching = true;
     bool useOccupancyAccept = true;
@@ -64,7 +72,7 @@ struct SchedulerParams {
     /// because shrinking its boxes was costly; transforming 8 corners is not, so the
     /// default tightens at once, moving objects included.
     std::uint32_t tightenAfterFrames = 0;
-    /// What object nodes are queried with once tightened (Full with useTightVolumes):
+    /// What object nodes are queried with once tightened (Queries and TwoPhase with useTightVolumes):
     /// the node's stored volume of this kind under the object's matrix. Aabb is the
     /// transformed local box; Auto picks per node (chooseVolume in node_volumes.hpp).
     /// Scene nodes, Simple mode and untightened objects always use world AABBs; frustum
@@ -80,14 +88,14 @@ struct SchedulerParams {
     /// stall forever). Generous because a query answers only after everything submitted
     /// before it is rasterised, which on a loaded software rasteriser can take a second.
     double queryTimeoutMs = 2000.0;
-    /// Simple and Full: the nodes met first in front-to-back order are drawn without a
+    /// Simple and Queries: the nodes met first in front-to-back order are drawn without a
     /// query until this percentage of the leaves inside the frustum has been reached (the
     /// front-most leaves are rarely occluded: k-DOP bounding volumes for occlusion, section
     /// 4, which uses about 5% for CAD and 10-15% for architecture). Costs one hierarchical
     /// frustum count per frame; conservative (it only adds draws). 0 = off, at most 100.
     float frontPercent = 0.0f;
 
-    // Approximate settings (Full only). Each may drop visible pixels; `dyncull bench`
+    // Approximate settings (Queries only). Each may drop visible pixels; `dyncull bench`
     // measures how many. Defaults are conservative.
     /// Cull nodes whose screen rectangle covers fewer than this many pixels (0 = off).
     std::uint32_t smallFeaturePixels = 0;
@@ -116,7 +124,7 @@ struct SchedulerParams {
     /// (the late pass cannot start before the early pass is rasterised); it tests again
     /// every `probeFrames` frames to see whether that has changed. Costs in nanoseconds of
     /// GL time; the defaults were measured on llvmpipe at 640x360 (`bench_draw_speed`,
-    /// `bench_volume_tests`, and for the readback `twophase-hzb` against `vfc` on Sponza;
+    /// `bench_volume_tests`, and for the readback `full-hzb` against `vfc` on Sponza;
     /// docs/BENCHMARKS.md), and another GL needs its own.
     struct TestCosts {
         double drawNsPerTriangle = 53.0;
@@ -156,7 +164,7 @@ struct NodeTrace {
 /// Validates ranges (e.g. tile size > 0, maxQueriesInFlight > 0, autoVolumeSaving in [0, 1]).
 Status validateSchedulerParams(const SchedulerParams& p);
 
-/// The world-space volume Full queries object node `ref` with once tightened: the node's
+/// The world-space volume Queries and TwoPhase test object node `ref` with once tightened: the node's
 /// stored volume of kind chooseVolume(volume, autoSaving) — its local box for Aabb, or
 /// when the model has no volumes — under the object's current matrix. Its world AABB
 /// (`objects`' worldBox of the node) for a node with no stored vertices.
@@ -217,7 +225,7 @@ private:
     std::uint32_t countFrustumLeaves() const;
     void runVfc();
     void runSimple();
-    void runFull();
+    void runQueries();
     void runTwoPhase();  // two_phase.cpp
     /// A query volume's screen rectangle and nearest window depth (reversed Z: the largest
     /// of its points'), the volume grown by its vertices' rounding first; false if it
