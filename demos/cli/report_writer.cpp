@@ -435,7 +435,7 @@ Status writeReport(const BenchResult& r, const std::vector<ModeSummary>& summary
       << "- loose-BSP relink: " << fmt(updateMs / n, 2) << " ms per frame, done once per frame before the modes "
       << "(not counted in any mode)\n"
       << "- modes run interleaved: per frame the scene moves once, then every mode renders that frame with its own "
-         "scheduler and history, vfc first (its image is the reference)\n\n";
+         "scheduler and history, vfc first (its image is the reference), the others in an order rotated every frame\n\n";
     f << "| mode | ms/frame | median | vs vfc | vs oracle | parts drawn | triangles | queries | occluded | sched ms | query ms | wait ms |"
          " % px wrong (mean) | % px wrong (max) | frames wrong | false neg. (parts) | false neg. (px) |"
          " false pos./frame | largest wrong region (px) | timeouts |\n"
