@@ -62,6 +62,7 @@ void QueryScheduler::runTwoPhase() {
     const NodeRef root = active_.empty() ? NodeRef{} : active_.back();
 
     // 1. Early pass. lastTouchedFrame marks a part drawn in it.
+    const std::uint32_t partsBefore = stats_->partsDrawn;
     while (!active_.empty()) {
         const NodeRef ref = active_.back();
         active_.pop_back();
@@ -80,6 +81,8 @@ void QueryScheduler::runTwoPhase() {
             h.lastTouchedFrame = frame_;
         }
     }
+
+    const bool drewEarly = stats_->partsDrawn > partsBefore;
 
     // 2. The early pass's depth, unless the cost model turned this frame's tests off. A
     // backend that cannot read depth leaves the pyramid unbuilt, and an unbuilt pyramid
@@ -214,7 +217,10 @@ void QueryScheduler::runTwoPhase() {
             history_.recordAnswer(history_.at(refresh_[i].ref, objs), visible, frame_);
         }
     }
-    if (testing) {
+    // A frame with no early depth (the first, or after everything turned hidden) had
+    // nothing to test the pyramid against, so only the final-depth tests measured what
+    // testing saves; without them the frame says nothing and the estimate stands.
+    if (testing && (drewEarly || !refresh_.empty())) {
         lastTestedFrame_ = frame_;
         savedNs_ = double(culledTriangles_) * params_.costs.drawNsPerTriangle;
     }
