@@ -1011,3 +1011,27 @@ TEST(TwoPhaseCosts, PartsAreTestedOnlyWhereTheTestPays) {
         }
     }
 }
+
+// The first frame has no early depth: in full-hzb (no final-depth test) it measures no
+// saving, and must not switch the tests off for it.
+TEST(TwoPhaseCosts, AFrameWithoutEarlyDepthDoesNotTurnTheTestsOff) {
+    TestScene s(4, 3);
+    DepthBackend backend;
+    SchedulerParams p = twoPhase();
+    p.useBatchedRaster = false;
+    p.costs.depthReadNs = 1000.0;
+    QueryScheduler sched(p);
+    TwoLevelTree tree(s.bsp, s.objects);
+    RecordingSink first;
+    sched.cullFrame(tree, frontCamera(), 640, 320, backend, first);
+    EXPECT_EQ(first.drawn, vfcDrawn(s));
+    backend.depth = 1.0f;  // everything hidden from now on
+    RecordingSink second;
+    sched.cullFrame(tree, frontCamera(), 640, 320, backend, second);
+    EXPECT_EQ(backend.reads, 2);
+    // The parts drawn early are last frame's; the late pass culls every other node.
+    RecordingSink third;
+    sched.cullFrame(tree, frontCamera(), 640, 320, backend, third);
+    EXPECT_EQ(backend.reads, 3);
+    EXPECT_TRUE(third.drawn.empty());
+}
