@@ -226,12 +226,10 @@ void QueryScheduler::runTwoPhase() {
     }
 }
 
-bool QueryScheduler::worthTesting(NodeRef ref, const ScreenRect& rect, double occludedRate) const {
+bool QueryScheduler::worthTesting(NodeRef ref, const ScreenRect& rect, double occludedRate) {
     if (!params_.useCostModel) return true;
-    const SceneObjects& objs = tree_->objects();
-    const double triangles = objs.model(objs.modelOf(ref.object)).nodes[ref.node].indexCount / 3;
     const SchedulerParams::TestCosts& c = params_.costs;
-    return occludedRate * triangles * c.drawNsPerTriangle > c.testNsPerVolume + c.testNsPerPixel * rect.area();
+    return occludedRate * double(subtreeTriangles(ref)) * c.drawNsPerTriangle > c.testNsPerVolume + c.testNsPerPixel * rect.area();
 }
 
 std::uint64_t QueryScheduler::subtreeTriangles(NodeRef ref) {
@@ -255,8 +253,7 @@ std::uint64_t QueryScheduler::subtreeTriangles(NodeRef ref) {
 bool QueryScheduler::exploring(NodeRef ref) const {
     // One new part in eight, a different eighth each frame, is tested whatever the model
     // expects, so a rate that fell while nothing was occluded can rise again.
-    const std::uint32_t hash = (ref.object * 2654435761u) ^ (ref.node * 2246822519u);
-    return ((hash >> 5) + frame_) % 8 == 0;
+    return ((hashNode(ref) >> 5) + frame_) % 8 == 0;
 }
 
 void QueryScheduler::rasterTest(const std::vector<TestedPart>& parts) {

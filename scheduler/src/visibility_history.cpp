@@ -66,7 +66,7 @@ std::uint32_t VisibilityHistory::postponement(NodeRef ref, const NodeHistory& h,
     if (visibleAnswers < p.minVisibleToSkip) return 0;
     std::uint32_t skip = std::min(p.maxSkipFrames, p.skipFramesPerVisible * visibleAnswers);
     if (p.jitter && skip >= 2) {
-        const std::uint32_t hash = (ref.object * 2654435761u) ^ (ref.node * 2246822519u) ^ 0x9e3779b9u;
+        const std::uint32_t hash = hashNode(ref) ^ 0x9e3779b9u;
         skip -= (hash >> 7) % (skip / 2 + 1);
     }
     return skip;

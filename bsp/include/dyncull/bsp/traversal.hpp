@@ -24,6 +24,10 @@ struct NodeRef {
     friend bool operator==(const NodeRef&, const NodeRef&) = default;
 };
 
+/// A mixed 32-bit hash of a node (multiplicative, per field), for spreading per-node work
+/// such as re-tests over frames.
+inline std::uint32_t hashNode(NodeRef r) { return (r.object * 2654435761u) ^ (r.node * 2246822519u); }
+
 /// Read-only view over a scene's two levels. Cheap to construct each frame; does not own.
 class TwoLevelTree {
 public:

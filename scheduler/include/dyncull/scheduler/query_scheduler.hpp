@@ -276,7 +276,7 @@ private:
     std::vector<std::uint32_t> scratchIndices_;  // subtreeTriangles' stack
     /// True if testing part `ref`, whose volume covers `rect`, is expected to save more
     /// drawing than it costs, given that a fraction `occludedRate` of such tests cull.
-    bool worthTesting(NodeRef ref, const ScreenRect& rect, double occludedRate) const;
+    bool worthTesting(NodeRef ref, const ScreenRect& rect, double occludedRate);
     /// True for the new parts tested this frame whatever the cost model expects.
     bool exploring(NodeRef ref) const;
     std::vector<QueryVolume> rasterVolumes_;
