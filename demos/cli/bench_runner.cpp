@@ -329,8 +329,8 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
     });
     std::vector<ModeFrame> row(result_.modes.size());
     // vfc first (its image is the reference), the others in an order rotated every frame:
-    // the mode right after vfc ran measurably slower on llvmpipe (the same work took 0.55
-    // and 0.63 of vfc's time by position alone), so no mode may always take that place.
+    // the mode right after vfc ran measurably slower on llvmpipe (docs/BENCHMARKS.md), so
+    // no mode may always take that place.
     const std::size_t n = result_.modes.size(), turn = result_.frames.size();
     for (std::size_t k = 0; k < n; ++k) {
         const std::size_t m = k == 0 ? 0 : 1 + (k - 1 + turn) % (n - 1);
