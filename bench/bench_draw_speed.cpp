@@ -96,7 +96,8 @@ public:
     /// returns triangles drawn.
     std::uint64_t draw(Engine& engine, bool cullBackFaces, bool sorted = true) {
         Renderer& r = engine.renderer();
-        r.beginFrame(engine.camera());  // binds, clears and sets the depth convention like a frame
+        engine.context().clearFramebuffer(Renderer::kClearColour);
+        r.beginFrame(engine.camera());  // the depth convention of a frame
         glUseProgram(program_);
         glUniformMatrix4fv(locViewProj_, 1, GL_FALSE, glm::value_ptr(engine.camera().viewProjectionRelative()));
         if (cullBackFaces) glEnable(GL_CULL_FACE);
@@ -169,7 +170,9 @@ struct Swarm {
 Swarm makeSwarm(GlContext& ctx, BunnySwarmOptions options) {
     Swarm s;
     s.scene = makeBunnySwarm(options);
-    auto engine = Engine::create(ctx);
+    EngineOptions eo;
+    eo.finishEachFrame = true;
+    auto engine = Engine::create(ctx, eo);
     if (!engine) fail(engine.error().message);
     s.engine = engine.take();
     if (Status st = s.scene->populate(*s.engine); !st) fail(st.message());
@@ -245,9 +248,10 @@ int main(int argc, char** argv) {
         return [&s, shading, cull, discard]() -> std::uint64_t {
             s.engine->renderer().setShading(shading);
             s.engine->renderer().setBackFaceCulling(cull);
-            if (discard) glEnable(GL_RASTERIZER_DISCARD);
+            s.engine->renderer().setRasteriserDiscard(discard);
+            s.engine->context().clearFramebuffer(Renderer::kClearColour);
             auto st = s.engine->renderFrame(s.vfc);
-            glDisable(GL_RASTERIZER_DISCARD);
+            s.engine->renderer().setRasteriserDiscard(false);
             s.engine->renderer().setShading(Shading::Vertex);
             s.engine->renderer().setBackFaceCulling(true);
             if (!st) fail(st.error().message);

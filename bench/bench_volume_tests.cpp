@@ -111,6 +111,7 @@ int main(int argc, char** argv) {
     for (int round = -1; round < rounds; ++round) {  // round -1 warms the shaders up, untimed
         for (Case& c : cases) {
             const std::vector<QueryVolume> vols = boxes(cam, c.side, c.count, c.visible ? 0.5f : -0.5f, rng);
+            (*ctx)->clearFramebuffer(Renderer::kClearColour);
             (*renderer)->beginFrame(cam);
             (*renderer)->drawMesh(*wallId, glm::mat4(1.0f), {0.5f, 0.5f, 0.5f});
             (*backend)->beginFrame(cam, kWidth, kHeight);

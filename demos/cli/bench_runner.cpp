@@ -338,6 +338,7 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
         engine_.setQueryParams(spec.queries);
         recorder_.clear();
         if (schedulers_[m]) schedulers_[m]->setTrace(&trace_);
+        engine_.context().clearFramebuffer(Renderer::kClearColour);
         auto rendered = spec.oracle ? engine_.renderParts(oracleParts_) : engine_.renderFrame(*schedulers_[m]);
         if (schedulers_[m]) schedulers_[m]->setTrace(nullptr);
         if (!rendered) {
@@ -462,7 +463,9 @@ Status runMeasurement(const MeasureOptions& o, std::vector<ModeSpec> modes, cons
     co.height = o.size.y;
     auto context = GlContext::create(co);
     if (!context) return Error{context.error().message};
-    auto engineOr = Engine::create(**context);
+    EngineOptions eo;
+    eo.finishEachFrame = true;  // frame times include the GPU's work
+    auto engineOr = Engine::create(**context, eo);
     if (!engineOr) return Error{engineOr.error().message};
     Engine& engine = **engineOr;
     if (Status s = scene.populate(engine); !s) return s;

@@ -88,6 +88,7 @@ void runRun(RunOptions o) {
     GlContext& ctx = **context;
 
     EngineOptions eo;
+    eo.finishEachFrame = true;  // frame times include the GPU's work
     eo.scheduler = toParams(o.flags, *mode);
     eo.queries.visiblePixelThreshold = o.flags.pixelThreshold;
     auto engineOr = Engine::create(ctx, eo);
@@ -143,6 +144,7 @@ void runRun(RunOptions o) {
             fail(o.scene + ": frame " + std::to_string(frame) + ": the scene's camera path gives an unusable camera (" +
                  s.message() + ")" + (o.sceneOptions.bunny.orbit > 0.0f ? "; check --orbit" : ""));
         if (boxView) boxView->trace(engine.scheduler(), true);
+        ctx.clearFramebuffer(Renderer::kClearColour);
         auto rendered = engine.renderFrame();
         if (!rendered) fail("frame " + std::to_string(frame) + ": " + rendered.error().message);
         const FrameStats& st = *rendered;

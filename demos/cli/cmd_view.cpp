@@ -28,6 +28,7 @@ struct ViewOptions {
 };
 
 void drawScene(Renderer& renderer, const Scene& scene, const std::vector<MeshId>& ids, const Camera& camera) {
+    renderer.context().clearFramebuffer(Renderer::kClearColour);
     renderer.beginFrame(camera);
     for (std::size_t i = 0; i < scene.instances.size(); ++i) {
         const Instance& inst = scene.instances[i];

@@ -138,6 +138,7 @@ Status InteractiveViewer::step(const InputFrame& input, double dtSeconds) {
 
     QueryScheduler& scheduler = *schedulers_[static_cast<int>(state_.mode)];
     view_.trace(scheduler, state_.boxes);
+    engine_.context().clearFramebuffer(Renderer::kClearColour);
     auto rendered = engine_.renderFrame(scheduler);
     if (!rendered) return Error{rendered.error().message};
     state_.last = *rendered;
@@ -165,7 +166,7 @@ Expected<std::uint64_t> runInteractive(GlContext& context, Engine& engine, DemoS
     double dt = 0.0;
     while (options.maxFrames == 0 || viewer.state().framesRendered < options.maxFrames) {
         const InputFrame in = input.poll();
-        if (Status s = viewer.step(in, dt); !s) return Error{s.message()};
+        if (Status s = viewer.step(in, dt); !s) return s.error();
         if (viewer.state().quit) break;
         context.present();
         const auto now = Clock::now();

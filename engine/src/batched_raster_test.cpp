@@ -62,6 +62,7 @@ Expected<std::unique_ptr<BatchedRasterTest>> BatchedRasterTest::create(GlContext
 }
 
 BatchedRasterTest::~BatchedRasterTest() {
+    if (!context_.isCurrent()) return;  // never delete another context's objects: these die with ours
     for (Batch& b : batches_) glDeleteBuffers(1, &b.buffer);
     glDeleteVertexArrays(1, &vao_);
     glDeleteBuffers(1, &vbo_);

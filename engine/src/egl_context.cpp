@@ -69,17 +69,25 @@ public:
     EglContext() : GlContext(ContextKind::HeadlessEgl) {}
     ~EglContext() override {
         if (context_ != EGL_NO_CONTEXT) {
+            // Whatever context the caller had current is current again afterwards.
+            const EGLContext previous = eglGetCurrentContext();
+            const EGLDisplay previousDisplay = eglGetCurrentDisplay();
+            const EGLSurface previousDraw = eglGetCurrentSurface(EGL_DRAW), previousRead = eglGetCurrentSurface(EGL_READ);
             eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_);
+            releaseCommon();
             if (framebuffer_) glDeleteFramebuffers(1, &framebuffer_);
             if (colour_) glDeleteRenderbuffers(1, &colour_);
             if (depth_) glDeleteRenderbuffers(1, &depth_);
             eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
             eglDestroyContext(display_, context_);
+            if (previous != EGL_NO_CONTEXT && previous != context_)
+                eglMakeCurrent(previousDisplay, previousDraw, previousRead, previous);
         }
         if (display_ != EGL_NO_DISPLAY) releaseDisplay(display_);
     }
 
     void makeCurrent() override { eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_); }
+    void releaseCurrent() override { eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT); }
     void present() override { glFlush(); }
 
     // Initialise `dpy` and create a current context on it; on failure returns why and
@@ -203,7 +211,7 @@ Expected<std::unique_ptr<GlContext>> createEglContext(const ContextOptions& o) {
     }
 
     if (!ctx) ctx = attempt(eglGetDisplay(EGL_DEFAULT_DISPLAY), "default display");
-    if (!ctx) return Error{"EGL: " + tried};
+    if (!ctx) return Error{"EGL: " + tried, ErrorCode::Unsupported};
 
     ctx->initCommon(o.debug);
     return std::unique_ptr<GlContext>(std::move(ctx));

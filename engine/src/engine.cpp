@@ -5,6 +5,8 @@
 
 #include <epoxy/gl.h>
 
+#include "gl_state_scope.hpp"
+
 namespace dyncull {
 
 struct Engine::Sink final : PartSink {
@@ -24,18 +26,34 @@ struct Engine::Sink final : PartSink {
 };
 
 Engine::Engine(GlContext& context, const EngineOptions& options)
-    : context_(context), tree_(options.sceneTree), scheduler_(options.scheduler) {}
+    : context_(context),
+      tree_(options.sceneTree),
+      scheduler_(options.scheduler),
+      finishEachFrame_(options.finishEachFrame) {}
+
+Status Engine::enterGl(const char* what) {
+    if (Status s = context_.checkCurrent(what); !s) return s;
+    if (Status s = context_.checkReset(); !s) return s;
+    callerGlErrors_ += context_.takeCallerErrors();
+    return {};
+}
+
+Status Engine::leaveGl(const char* what) {
+    if (Status s = context_.checkReset(); !s) return s;
+    return context_.checkErrorsDuring(what);
+}
 
 Expected<std::unique_ptr<Engine>> Engine::create(GlContext& context, const EngineOptions& options) {
-    if (Status s = validateSchedulerParams(options.scheduler); !s) return Error{s.message()};
-    if (Status s = context.checkReset(); !s) return Error{s.message()};
+    if (Status s = validateSchedulerParams(options.scheduler); !s) return s.error();
     std::unique_ptr<Engine> e(new Engine(context, options));
+    if (Status s = e->enterGl("creating the engine"); !s) return s.error();
     auto renderer = Renderer::create(context);
     if (!renderer) return renderer.error();
     e->renderer_ = renderer.take();
     auto backend = GlQueryBackend::create(context, options.queries);
     if (!backend) return backend.error();
     e->backend_ = backend.take();
+    if (Status s = e->leaveGl("creating the engine"); !s) return s.error();
     const glm::ivec2 size = context.size();
     e->camera_.aspect = static_cast<float>(size.x) / static_cast<float>(size.y);
     return e;
@@ -48,10 +66,11 @@ Expected<ModelId> Engine::addModel(const Mesh& mesh, const LocalBspParams& param
 }
 
 Expected<ModelId> Engine::addModel(LocalBsp bsp) {
-    if (Status s = context_.checkReset(); !s) return Error{s.message()};
+    if (Status s = enterGl("adding a model"); !s) return s.error();
     // Upload first: if the GPU refuses, nothing has been registered yet.
     auto mesh = renderer_->upload(bsp.mesh, bsp.faces);
     if (!mesh) return mesh.error();
+    if (Status s = leaveGl("adding a model"); !s) return s.error();
     const ModelId id = objects_.addModel(std::move(bsp));
     if (meshOfModel_.size() <= id) meshOfModel_.resize(id + 1);
     meshOfModel_[id] = *mesh;
@@ -103,31 +122,35 @@ LooseBspFrameStats Engine::updateSceneTree() {
 }
 
 Expected<FrameStats> Engine::renderFrame(QueryScheduler& scheduler) {
-    if (Status s = context_.checkReset(); !s) return Error{s.message()};
+    if (Status s = enterGl("renderFrame"); !s) return s.error();
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();
     const double updateMs = updateSceneTree().updateMs;
 
+    detail::GlStateScope scope;
+    const FrameTarget& target = scope.target();
+    backend_->setTarget(target);
     renderer_->beginFrame(camera_);
     Sink sink(*this);
     TwoLevelTree tree(tree_, objects_);
-    const glm::ivec2 size = context_.size();
-    FrameStats st = scheduler.cullFrame(tree, camera_, size.x, size.y, *backend_, sink);
+    FrameStats st = scheduler.cullFrame(tree, camera_, target.width(), target.height(), *backend_, sink);
     renderer_->endFrame();
     if (finishEachFrame_) glFinish();
+    scope.restore();
     // A reset during the frame: its image and query results are undefined, so report it.
-    if (Status s = context_.checkReset(); !s) return Error{s.message()};
-    if (!backend_->frameStatus()) return Error{backend_->frameStatus().message()};
+    if (Status s = leaveGl("renderFrame"); !s) return s.error();
+    if (!backend_->frameStatus()) return backend_->frameStatus().error();
     st.updateMs = updateMs;
     st.frameMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
     return st;
 }
 
 Expected<FrameStats> Engine::renderParts(const std::vector<NodeRef>& parts) {
-    if (Status s = context_.checkReset(); !s) return Error{s.message()};
+    if (Status s = enterGl("renderParts"); !s) return s.error();
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();
     const double updateMs = updateSceneTree().updateMs;
+    detail::GlStateScope scope;
     renderer_->beginFrame(camera_);
     Sink sink(*this);
     FrameStats st;
@@ -145,7 +168,8 @@ Expected<FrameStats> Engine::renderParts(const std::vector<NodeRef>& parts) {
     st.nodesVisited = st.partsDrawn;
     renderer_->endFrame();
     if (finishEachFrame_) glFinish();
-    if (Status s = context_.checkReset(); !s) return Error{s.message()};
+    scope.restore();
+    if (Status s = leaveGl("renderParts"); !s) return s.error();
     st.updateMs = updateMs;
     st.frameMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
     return st;

@@ -79,6 +79,10 @@ Expected<std::unique_ptr<GlQueryBackend>> GlQueryBackend::create(GlContext& cont
 }
 
 GlQueryBackend::~GlQueryBackend() {
+    if (!context_.isCurrent()) {
+        batches_.reset();  // its buffers, like ours, die with their own context
+        return;
+    }
     // Deleting a query drops its fence reference: first let every fence finish signalling
     // (see free_ in the header).
     glFinish();
@@ -184,17 +188,30 @@ void GlQueryBackend::endDrawQuery(QueryId id) {
 }
 
 bool GlQueryBackend::readDepth(std::vector<float>& depth, int& width, int& height) {
-    const glm::ivec2 size = context_.size();
-    width = size.x;
-    height = size.y;
+    if (!hasTarget_ || !target_.depthReadable) return false;
+    width = target_.width();
+    height = target_.height();
     depth.resize(static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
-    GLint readFbo = 0, alignment = 4;
+    // Into client memory, tightly packed, whatever pack state the caller left.
+    GLint readFbo = 0, packBuffer = 0, alignment = 4, rowLength = 0, skipRows = 0, skipPixels = 0;
     glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &readFbo);
+    glGetIntegerv(GL_PIXEL_PACK_BUFFER_BINDING, &packBuffer);
     glGetIntegerv(GL_PACK_ALIGNMENT, &alignment);
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, context_.framebuffer());
+    glGetIntegerv(GL_PACK_ROW_LENGTH, &rowLength);
+    glGetIntegerv(GL_PACK_SKIP_ROWS, &skipRows);
+    glGetIntegerv(GL_PACK_SKIP_PIXELS, &skipPixels);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, target_.framebuffer);
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
-    glReadPixels(0, 0, width, height, GL_DEPTH_COMPONENT, GL_FLOAT, depth.data());
+    glPixelStorei(GL_PACK_ROW_LENGTH, 0);
+    glPixelStorei(GL_PACK_SKIP_ROWS, 0);
+    glPixelStorei(GL_PACK_SKIP_PIXELS, 0);
+    glReadPixels(target_.viewport.x, target_.viewport.y, width, height, GL_DEPTH_COMPONENT, GL_FLOAT, depth.data());
     glPixelStorei(GL_PACK_ALIGNMENT, alignment);
+    glPixelStorei(GL_PACK_ROW_LENGTH, rowLength);
+    glPixelStorei(GL_PACK_SKIP_ROWS, skipRows);
+    glPixelStorei(GL_PACK_SKIP_PIXELS, skipPixels);
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, static_cast<GLuint>(packBuffer));
     glBindFramebuffer(GL_READ_FRAMEBUFFER, static_cast<GLuint>(readFbo));
     return true;
 }

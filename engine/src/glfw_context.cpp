@@ -35,15 +35,19 @@ public:
     GlfwContext() : GlContext(ContextKind::GlfwWindow) {}
     ~GlfwContext() override {
         if (window_) {
+            GLFWwindow* previous = glfwGetCurrentContext();
             glfwMakeContextCurrent(window_);
+            releaseCommon();
             if (framebuffer_) glDeleteFramebuffers(1, &framebuffer_);
             if (colour_) glDeleteRenderbuffers(1, &colour_);
             if (depth_) glDeleteRenderbuffers(1, &depth_);
             glfwDestroyWindow(window_);
+            if (previous != window_) glfwMakeContextCurrent(previous);  // the caller's context stays current
         }
         if (--liveWindows() == 0) glfwTerminate();
     }
     void makeCurrent() override { glfwMakeContextCurrent(window_); }
+    void releaseCurrent() override { glfwMakeContextCurrent(nullptr); }
     void present() override {
         glBlitNamedFramebuffer(framebuffer_, 0, 0, 0, size_.x, size_.y, 0, 0, size_.x, size_.y, GL_COLOR_BUFFER_BIT,
                                GL_NEAREST);
@@ -84,7 +88,7 @@ public:
 Expected<std::unique_ptr<GlContext>> createGlfwContext(const ContextOptions& o) {
     glfwSetErrorCallback(onGlfwError);
     lastGlfwError().clear();
-    if (!glfwInit()) return Error{"GLFW: glfwInit failed: " + lastGlfwError()};
+    if (!glfwInit()) return Error{"GLFW: glfwInit failed: " + lastGlfwError(), ErrorCode::Unsupported};
     auto ctx = std::make_unique<GlfwContext>();
     ++liveWindows();  // balanced by ~GlfwContext even on failure below
 

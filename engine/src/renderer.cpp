@@ -33,18 +33,16 @@ Expected<std::unique_ptr<Renderer>> Renderer::create(GlContext& context) {
         p.eye = glGetUniformLocation(p.id, "uEye");  // -1 in the per-vertex program (the eye is the origin)
         p.light = glGetUniformLocation(p.id, "uLightDir");
     }
-    r->boxes_ = std::make_unique<BoxDrawer>();
-    if (!r->boxes_->valid()) return Error{std::string("renderer: box shader rejected: ") + r->boxes_->log()};
     return r;
 }
 
 Renderer::~Renderer() {
+    if (!context_.isCurrent()) return;  // never delete another context's objects: these die with ours
     for (GpuMesh& m : meshes_) {
         glDeleteVertexArrays(1, &m.vao);
         glDeleteBuffers(1, &m.vbo);
         glDeleteBuffers(1, &m.ibo);
     }
-    boxes_.reset();
     for (const LitProgram& p : programs_)
         if (p.id) glDeleteProgram(p.id);
 }
@@ -80,13 +78,13 @@ Expected<MeshId> Renderer::upload(const Mesh& mesh, FaceMode faces) {
     glNamedBufferStorage(g.vbo, vbytes ? vbytes : 1, vbytes ? interleaved.data() : nullptr, 0);
     if (Status s = context_.checkAllocation(what, totalBytes); !s) {
         discard();
-        return Error{s.message()};
+        return s.error();
     }
     glCreateBuffers(1, &g.ibo);
     glNamedBufferStorage(g.ibo, ibytes ? ibytes : 1, ibytes ? src->indices.data() : nullptr, 0);
     if (Status s = context_.checkAllocation(what, totalBytes); !s) {
         discard();
-        return Error{s.message()};
+        return s.error();
     }
     glCreateVertexArrays(1, &g.vao);
     glVertexArrayVertexBuffer(g.vao, 0, g.vbo, 0, 2 * sizeof(glm::vec3));
@@ -104,19 +102,15 @@ Expected<MeshId> Renderer::upload(const Mesh& mesh, FaceMode faces) {
 
 void Renderer::beginFrame(const Camera& camera) {
     stats_ = {};
-    const glm::ivec2 size = context_.size();
-    glBindFramebuffer(GL_FRAMEBUFFER, context_.framebuffer());
-    glViewport(0, 0, size.x, size.y);
-    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    glDepthMask(GL_TRUE);
-    glClearColor(kClearColour.r, kClearColour.g, kClearColour.b, 1.0f);
+    // Into the framebuffer and viewport the caller bound, over what it holds (no clear).
     detail::useReversedDepth();
-    glClearDepth(detail::kDepthCleared);
-    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(detail::kDepthNearer);
+    glDepthMask(GL_TRUE);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     // Back faces are culled per mesh (GpuMesh::cullBack); drawRange switches the state.
     detail::resetFaceCulling(cullEnabled_, frontCcw_);
+    if (discard_) glEnable(GL_RASTERIZER_DISCARD);
 
     viewProj_ = camera.viewProjection();
     // Camera-relative transforms: uViewProj has no translation and uModel carries the
@@ -166,15 +160,10 @@ void Renderer::drawRange(MeshId id, std::uint32_t firstIndex, std::uint32_t coun
     stats_.triangles += count / 3;
 }
 
-void Renderer::drawBoxDepthTestOnly(const Aabb& box, const glm::mat4& model) {
-    boxes_->drawDepthTestOnly(box, model, viewProj_);
-    ++stats_.boxes;
-}
-
 void Renderer::endFrame() {
     detail::resetFaceCulling(cullEnabled_, frontCcw_);  // as beginFrame left it, whatever was drawn last
+    if (discard_) glDisable(GL_RASTERIZER_DISCARD);
     glFlush();
-    context_.checkErrors();
 }
 
 void Renderer::finish() const { glFinish(); }

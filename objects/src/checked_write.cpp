@@ -8,7 +8,7 @@ namespace dyncull {
 namespace {
 
 Error writeError(const std::filesystem::path& path, const char* what, int err) {
-    return Error{path.string() + ": " + what + (err ? std::string(": ") + std::strerror(err) : std::string())};
+    return Error{path.string() + ": " + what + (err ? std::string(": ") + std::strerror(err) : std::string()), ErrorCode::Io};
 }
 
 }  // namespace

@@ -431,7 +431,7 @@ struct PendingInstance {
 
 Expected<Scene> loadGltfImpl(const std::filesystem::path& path) {
     std::string bytes;
-    if (Status s = detail::readWholeFile(path, bytes); !s) return Error{s.message()};
+    if (Status s = detail::readWholeFile(path, bytes); !s) return s.error();
     if (bytes.size() > std::numeric_limits<unsigned int>::max())
         return detail::fileError(path, "larger than 4 GiB, which tinygltf cannot address");
     std::string ext = path.extension().string();

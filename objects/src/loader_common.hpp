@@ -23,7 +23,7 @@ inline Error fileError(const std::filesystem::path& path, const std::string& wha
     for (char& c : msg)
         if (c == '\n' || c == '\r') c = ' ';
     while (!msg.empty() && msg.back() == ' ') msg.pop_back();
-    return Error{std::move(msg)};
+    return Error{std::move(msg), ErrorCode::BadFile};
 }
 
 /// Checks that `path` names a non-empty regular file (the common failures every loader

@@ -241,7 +241,7 @@ private:
 
 Expected<Scene> loadObjImpl(const std::filesystem::path& path) {
     std::string data;
-    if (Status s = detail::readWholeFile(path, data); !s) return Error{s.message()};
+    if (Status s = detail::readWholeFile(path, data); !s) return s.error();
     Scene scene;
     ObjParser parser;
     if (auto f = parser.parse(data, scene)) return detail::fileError(path, f->what);

@@ -467,7 +467,7 @@ std::uint64_t maxInstances(Format format, const Element& e, std::uint64_t dataBy
 
 Expected<Scene> loadPlyImpl(const std::filesystem::path& path) {
     std::string data;
-    if (Status s = detail::readWholeFile(path, data); !s) return Error{s.message()};
+    if (Status s = detail::readWholeFile(path, data); !s) return s.error();
     Header h;
     if (auto f = parseHeader(data, h)) return detail::fileError(path, f->what);
 

@@ -60,6 +60,7 @@ TEST(BatchedRasterTest, AnswersEveryVolumeAsOneHardwareQueryEach) {
     std::mt19937 rng(2026);
     int visible = 0, occluded = 0;
     for (int scene = 0; scene < 4; ++scene) {
+        ctx->clearFramebuffer(Renderer::kClearColour);
         r.beginFrame(cam);
         // Occluders: spheres and tilted quads scattered between the volumes.
         std::uniform_real_distribution<float> pos(-1.5f, 1.5f), z(-1.0f, 1.5f), s(0.2f, 0.9f);
@@ -103,6 +104,7 @@ TEST(BatchedRasterTest, NearPlaneVolumesAreVisibleUndrawnAndStateIsRestored) {
     GlQueryBackend& b = **backendOr;
     const Camera cam = test::cameraOnZ(3.0f);  // near plane at z = 2.9
     const MeshId wall = *r.upload(test::quadMesh(5.0f));  // fills the whole view at z = 0
+    ctx->clearFramebuffer(Renderer::kClearColour);
     r.beginFrame(cam);
     r.drawMesh(wall, glm::mat4(1.0f), {0.5f, 0.5f, 0.5f});
     b.beginFrame(cam, test::kW, test::kH);
@@ -223,6 +225,7 @@ TEST(VolumeSnapping, TheRingKeepsEveryPixelOfAPartInsideItsVolume) {
                                                 {std::max(bu, cu) + after, glm::dot(c - a, v), 0.2f});
             const QueryVolume volume = QueryVolume::fromTransformedBox(frame, local);
 
+            ctx->clearFramebuffer(Renderer::kClearColour);
             r.beginFrame(cam);
             r.drawMesh(id, glm::mat4(1.0f), {1, 1, 1});
             // Only pixel centres within a few snapping steps of line AB can be missed (elsewhere
@@ -236,6 +239,7 @@ TEST(VolumeSnapping, TheRingKeepsEveryPixelOfAPartInsideItsVolume) {
             const glm::dvec2 dir = glm::normalize(pb - pa), nrm(-dir.y, dir.x);
             for (const glm::ivec2 p : coveredPixels(r, kSize, kSize)) {
                 if (std::abs(glm::dot(glm::dvec2(p) + 0.5 - pa, nrm)) > 0.02) continue;
+                ctx->clearFramebuffer(Renderer::kClearColour);
                 r.beginFrame(cam);
                 r.drawMesh(id, glm::mat4(1.0f), {1, 1, 1});
                 // Everything but pixel p nearest (reversed Z: 1), so only p can pass.

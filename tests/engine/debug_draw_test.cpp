@@ -26,6 +26,7 @@ TEST(DebugDraw, BoxEdgesAppearAtTheirProjection) {
         ASSERT_TRUE(lines.valid()) << lines.log();
         const Camera cam = test::cameraOnZ(3.0f);
         const Aabb box = Aabb::fromMinMax({-0.5f, -0.5f, -0.5f}, {0.5f, 0.5f, 0.5f});
+        ctx->clearFramebuffer(Renderer::kClearColour);
         (*r)->beginFrame(cam);
         lines.addBox(box, {0, 1, 0, 1});
         EXPECT_EQ(lines.queuedLines(), 12u);
@@ -64,6 +65,7 @@ TEST(DebugDraw, DepthModesHideOrFadeLinesBehindGeometry) {
         const glm::ivec2 size = ctx->size();
         const glm::ivec2 px = project(cam.viewProjection(), {0.3f, 0.0f, -1.0f}, size);
         auto render = [&](LineDepth mode) {
+            ctx->clearFramebuffer(Renderer::kClearColour);
             (*r)->beginFrame(cam);
             (*r)->drawMesh(wall, glm::mat4(1.0f), {0.2f, 0.2f, 0.2f});
             lines.addBox(box, {1, 0, 0, 1});
@@ -90,6 +92,7 @@ TEST(DebugDraw, SegmentsCrossingTheEyePlaneAreClippedNotFlipped) {
         ASSERT_TRUE(r.ok()) << r.error().message;
         DebugDraw lines;
         const Camera cam = test::cameraOnZ(3.0f);
+        ctx->clearFramebuffer(Renderer::kClearColour);
         (*r)->beginFrame(cam);
         // From in front of the camera on the right to behind it: only the right half may light up.
         lines.addLine({0.5f, 0.0f, 0.0f}, {0.5f, 0.0f, 10.0f}, {1, 1, 1, 1});

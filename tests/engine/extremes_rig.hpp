@@ -86,14 +86,18 @@ struct Rig {
     Result frame(const Camera& camera) {
         Result r;
         EXPECT_TRUE(engine->setCamera(camera).ok());
+        ctx->clearFramebuffer(Renderer::kClearColour);
         r.vfcStats = *engine->renderFrame(vfc);
         r.vfcImage = engine->renderer().readPixels();
-        engine->renderFrame(full);
+        ctx->clearFramebuffer(Renderer::kClearColour);
+        EXPECT_TRUE(engine->renderFrame(full).ok());
         recorder.clear();
+        ctx->clearFramebuffer(Renderer::kClearColour);
         r.fullStats = *engine->renderFrame(full);
         r.fullImage = engine->renderer().readPixels();
         r.fullDrawn = recorder.drawn();
         recorder.clear();
+        ctx->clearFramebuffer(Renderer::kClearColour);
         r.queriesStats = *engine->renderFrame(queries);
         r.queriesImage = engine->renderer().readPixels();
         auto d = compareImages(r.vfcImage, r.queriesImage);

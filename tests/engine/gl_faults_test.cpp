@@ -52,6 +52,7 @@ struct FaultRig : ::testing::Test {
 
     Expected<FrameStats> frame() {
         partsThisFrame = 0;
+        ctx->clearFramebuffer(Renderer::kClearColour);
         return engine->renderFrame();
     }
 };
@@ -167,6 +168,7 @@ TEST_F(FaultRig, ContextLostBetweenFramesIsAnErrorFromThenOn) {
     st = frame();
     ASSERT_FALSE(st.ok());
     EXPECT_EQ(st.error().message, message);
+    ctx->clearFramebuffer(Renderer::kClearColour);
     auto parts = engine->renderParts({});
     ASSERT_FALSE(parts.ok());
     EXPECT_EQ(parts.error().message, message);

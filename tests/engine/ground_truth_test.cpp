@@ -47,7 +47,8 @@ struct QuadAndCube : ::testing::Test {
 
     /// Renders vfc and checks the ID image against it pixel by pixel.
     void expectCoverageMatchesRender(const VisibleSet& vs) {
-        engine->renderFrame();
+        ctx->clearFramebuffer(Renderer::kClearColour);
+        ASSERT_TRUE(engine->renderFrame().ok());
         const Image img = engine->renderer().readPixels();
         const std::vector<std::uint32_t>& ids = truth->idImage();
         ASSERT_EQ(ids.size(), static_cast<std::size_t>(img.width) * static_cast<std::size_t>(img.height));
@@ -110,7 +111,8 @@ TEST_F(QuadAndCube, DrawnPartsAreComparedWithTheTruth) {
     engine->setPartObserver([&](std::uint32_t o, std::uint32_t first, std::uint32_t count) {
         rec.record(engine->objects(), o, first, count);
     });
-    engine->renderFrame();  // vfc draws quad and hidden cube
+    ctx->clearFramebuffer(Renderer::kClearColour);
+    ASSERT_TRUE(engine->renderFrame().ok());  // vfc draws quad and hidden cube
     engine->setPartObserver(nullptr);
     const PartErrors e = compareParts(vs, rec.drawn());
     EXPECT_EQ(e.drawn, 2u);
@@ -121,6 +123,7 @@ TEST_F(QuadAndCube, DrawnPartsAreComparedWithTheTruth) {
     EXPECT_EQ(none.falseNegativePixels, vs.coveredPixels);
     // The oracle path draws exactly the visible set and gives the same picture as vfc.
     const Image vfcImage = engine->renderer().readPixels();
+    ctx->clearFramebuffer(Renderer::kClearColour);
     const FrameStats st = *engine->renderParts({{quad.index, 0}});
     EXPECT_EQ(st.partsDrawn, 1u);
     EXPECT_EQ(engine->renderer().readPixels().rgba, vfcImage.rgba);

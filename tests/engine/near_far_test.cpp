@@ -118,6 +118,7 @@ struct NearFarScene {
         Reference ref;
         const Camera any = camera(1.0f, 10.0f);
         EXPECT_TRUE(rig.engine->setCamera(any).ok());
+        rig.ctx->clearFramebuffer(Renderer::kClearColour);
         EXPECT_TRUE(rig.engine->renderParts({}).ok());
         const Image background = rig.engine->renderer().readPixels();
         ref.image = background;
@@ -127,6 +128,7 @@ struct NearFarScene {
             const float decade = std::pow(10.0f, float(layer));
             const Camera c = camera(0.3f * decade, 3.0f * decade);
             EXPECT_TRUE(rig.engine->setCamera(c).ok());
+            rig.ctx->clearFramebuffer(Renderer::kClearColour);
             EXPECT_TRUE(rig.engine->renderParts(partsOfLayer(layer)).ok());
             const Image img = rig.engine->renderer().readPixels();
             for (std::size_t i = 0; i < img.rgba.size(); i += 4)

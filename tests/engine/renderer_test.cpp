@@ -27,6 +27,7 @@ struct RendererTest : ::testing::Test {
 
 TEST_F(RendererTest, RedQuadFillsTheCentre) {
     const MeshId quad = *renderer->upload(test::quadMesh(0.5f));
+    ctx->clearFramebuffer(Renderer::kClearColour);
     renderer->beginFrame(test::cameraOnZ(3.0f));
     renderer->drawMesh(quad, glm::mat4(1.0f), {1, 0, 0});
     renderer->endFrame();
@@ -59,6 +60,7 @@ TEST_F(RendererTest, CulledClosedCubeLooksTwoSidedFromOutsideEvenMirrored) {
     for (const glm::mat4& model : {turned, glm::scale(turned, {-1.0f, 1.0f, 1.0f})}) {
         Image img[2];
         for (int i = 0; i < 2; ++i) {
+            ctx->clearFramebuffer(Renderer::kClearColour);
             renderer->beginFrame(test::cameraOnZ(3.0f));
             renderer->drawMesh(i == 0 ? culled : both, model, {0.8f, 0.5f, 0.2f});
             renderer->endFrame();
@@ -75,6 +77,7 @@ TEST_F(RendererTest, CulledClosedCubeLooksTwoSidedFromOutsideEvenMirrored) {
     // From inside, a closed surface shows only back faces: culled, nothing is drawn.
     Image inside[2];
     for (int i = 0; i < 2; ++i) {
+        ctx->clearFramebuffer(Renderer::kClearColour);
         renderer->beginFrame(test::cameraOnZ(0.1f));
         renderer->drawMesh(i == 0 ? culled : both, glm::mat4(1.0f), {0.8f, 0.5f, 0.2f});
         renderer->endFrame();
@@ -86,6 +89,7 @@ TEST_F(RendererTest, CulledClosedCubeLooksTwoSidedFromOutsideEvenMirrored) {
 
 TEST_F(RendererTest, ReadPixelsIsTopDown) {
     const MeshId quad = *renderer->upload(test::quadMesh(0.3f));
+    ctx->clearFramebuffer(Renderer::kClearColour);
     renderer->beginFrame(test::cameraOnZ(3.0f));
     renderer->drawMesh(quad, glm::translate(glm::mat4(1.0f), {0, 0.9f, 0}), {0, 0, 1});  // world up
     renderer->endFrame();
@@ -98,6 +102,7 @@ TEST_F(RendererTest, NearCubeHidesFarCubeRegardlessOfOrder) {
     const MeshId cube = *renderer->upload(test::cubeMesh(1.0f));
     const glm::mat4 nearM = glm::scale(glm::mat4(1.0f), glm::vec3(0.5f));
     const glm::mat4 farM = glm::scale(glm::translate(glm::mat4(1.0f), {0, 0, -3}), glm::vec3(1.5f));
+    ctx->clearFramebuffer(Renderer::kClearColour);
     renderer->beginFrame(test::cameraOnZ(3.0f));
     renderer->drawMesh(cube, nearM, {1, 0, 0});
     renderer->drawMesh(cube, farM, {0, 1, 0});  // drawn second, must lose the depth test in the middle
@@ -115,6 +120,7 @@ TEST_F(RendererTest, NearCubeHidesFarCubeRegardlessOfOrder) {
 
 TEST_F(RendererTest, SubRangeDrawsOnlyThoseTriangles) {
     const MeshId quad = *renderer->upload(test::quadMesh(0.5f));
+    ctx->clearFramebuffer(Renderer::kClearColour);
     renderer->beginFrame(test::cameraOnZ(3.0f));
     renderer->drawRange(quad, 3, 3, glm::mat4(1.0f), {1, 1, 1});  // second triangle: (0, 2, 3), upper-left half
     renderer->endFrame();
@@ -126,6 +132,7 @@ TEST_F(RendererTest, SubRangeDrawsOnlyThoseTriangles) {
 
 TEST_F(RendererTest, LightingShadesFacesDifferently) {
     const MeshId sphere = *renderer->upload(test::sphereMesh(1.0f));
+    ctx->clearFramebuffer(Renderer::kClearColour);
     renderer->beginFrame(test::cameraOnZ(4.0f));
     renderer->drawMesh(sphere, glm::mat4(1.0f), {0.8f, 0.8f, 0.8f});
     renderer->endFrame();
@@ -141,6 +148,7 @@ TEST_F(RendererTest, MissingNormalsAreComputedOnUpload) {
     m.normals.clear();
     const MeshId id = *renderer->upload(m);
     EXPECT_EQ(renderer->indexCount(id), 6u);
+    ctx->clearFramebuffer(Renderer::kClearColour);
     renderer->beginFrame(test::cameraOnZ(3.0f));
     renderer->drawMesh(id, glm::mat4(1.0f), {1, 0, 0});
     renderer->endFrame();

@@ -132,6 +132,7 @@ TEST(Soak, TenThousandFramesOfAMovingSwarm) {
         ASSERT_TRUE(scene->update(engine, f).ok());
         ASSERT_TRUE(engine.setCamera(scene->camera(f, aspect)).ok());
         recorder.clear();
+        ctx->clearFramebuffer(Renderer::kClearColour);
         auto rendered = engine.renderFrame();
         ASSERT_TRUE(rendered.ok()) << "frame " << f << ": " << rendered.error().message;
         const FrameStats& st = *rendered;

@@ -38,6 +38,7 @@ TEST(TextOverlay, GlyphPixelsMatchTheTable) {
         ASSERT_TRUE(r.ok()) << r.error().message;
         TextOverlay text;
         ASSERT_TRUE(text.valid()) << text.log();
+        ctx->clearFramebuffer(Renderer::kClearColour);
         (*r)->beginFrame(test::cameraOnZ());
         const int scale = 3;
         const glm::ivec2 at{7, 5};
@@ -77,6 +78,7 @@ TEST(TextOverlay, RectsBlendAndTextDrawsOverThem) {
         auto r = Renderer::create(*ctx);
         ASSERT_TRUE(r.ok()) << r.error().message;
         TextOverlay text;
+        ctx->clearFramebuffer(Renderer::kClearColour);
         (*r)->beginFrame(test::cameraOnZ());
         text.addRect({0, 0}, {40, 20}, {1, 0, 0, 0.5f});
         text.addText({2, 2}, "|", {0, 1, 0, 1}, 2);  // '|' lights column 2 of every row

@@ -30,6 +30,7 @@ TEST(Window, RendersIntoAFloatDepthFramebufferAndPresents) {
     Camera cam;
     cam.position = {0, 0, 3};
     cam.aspect = 64.0f / 48.0f;
+    (*ctx)->clearFramebuffer(Renderer::kClearColour);
     (*r)->beginFrame(cam);
     (*r)->drawMesh(quad, glm::mat4(1.0f), {1, 0, 0});
     (*r)->endFrame();

@@ -24,6 +24,9 @@ struct EngineOptions {
     LooseBspParams sceneTree;
     SchedulerParams scheduler;
     GlQueryParams queries;
+    /// glFinish at the end of every frame, so FrameStats::frameMs bounds the GPU work too
+    /// (measurement); off, a frame only submits its work, as a game wants.
+    bool finishEachFrame = false;
 };
 
 /// Draws one object part with the game's own renderer: `object` is the handle given by
@@ -38,11 +41,21 @@ using DrawPartCallback =
 /// index range of its model's split mesh. For measurement (which parts a mode drew).
 using PartObserver = std::function<void(std::uint32_t object, std::uint32_t firstIndex, std::uint32_t indexCount)>;
 
-/// Borrows the GL context (which must outlive the Engine and be current on calls).
+/// Borrows the GL context, which must outlive the Engine (a game's own context is wrapped
+/// with GlContext::borrowCurrent). Each frame it draws into the framebuffer and viewport the
+/// caller has bound and leaves the caller's GL state as it found it (frame_contract.hpp).
+///
+/// Threads: an Engine is used from one thread at a time, the one its context is current on;
+/// calls that touch GL (create, addModel, renderFrame, renderParts, the destructor) check
+/// that the context is current and otherwise fail with ErrorCode::WrongContext (the
+/// destructor then deletes no GL object: they die with their own context). Calls that do
+/// not touch GL (objects, transforms, camera, parameters) need no context. Two Engines on
+/// two contexts may run on two threads.
 class Engine {
 public:
-    /// Errors: invalid scheduler parameters, shaders rejected by the driver, GPU out of
-    /// memory for the query volume buffers, or the context already lost.
+    /// Errors: invalid scheduler parameters, the context not current (WrongContext) or
+    /// already lost, shaders rejected by the driver, GPU out of memory for the query volume
+    /// buffers.
     static Expected<std::unique_ptr<Engine>> create(GlContext& context, const EngineOptions& options = {});
 
     /// Builds the model's local BSP (object space) and uploads its split mesh once.
@@ -64,12 +77,14 @@ public:
     /// Per-object colour for dyncull's renderer (default: colourForId of the slot).
     void setColour(ObjectHandle object, const glm::vec3& colour);
 
-    /// One frame: relink moved objects, cull, draw, and glFinish (so frameMs bounds the
-    /// GPU work too). Does not present; windowed callers call context().present().
-    /// Errors: the GL context was lost (checked before and after the frame's GL work; from
-    /// then on every call returns the same error and does no GL work, see
-    /// GlContext::checkReset), or the query volume buffers could not be allocated (the
-    /// frame was still drawn, its unissued queries counted visible).
+    /// One frame: relink moved objects, cull, and draw into the bound framebuffer and
+    /// viewport (frame_contract.hpp: no clear, the caller's GL state restored; glFinish only
+    /// with EngineOptions::finishEachFrame). Does not present.
+    /// Errors: the context is not current (WrongContext; nothing done); the GL context was
+    /// lost (checked before and after the frame's GL work; from then on every call returns
+    /// the same error and does no GL work, see GlContext::checkReset); a GL error raised
+    /// during the frame, by dyncull or the draw callback (GlError); the query volume buffers
+    /// could not be allocated (the frame was still drawn, its unissued queries counted visible).
     Expected<FrameStats> renderFrame() { return renderFrame(scheduler_); }
     /// The same with another scheduler (its own mode, parameters and visibility history),
     /// so several configurations can be run interleaved over the same frames of one scene.
@@ -82,8 +97,11 @@ public:
     void setPartObserver(PartObserver observer) { observer_ = std::move(observer); }
     /// Relinks moved objects now (renderFrame does it too; calling twice costs nothing).
     LooseBspFrameStats updateSceneTree();
-    /// When false, renderFrame skips the final glFinish (frameMs then excludes GPU time).
+    /// See EngineOptions::finishEachFrame.
     void setFinishEachFrame(bool finish) { finishEachFrame_ = finish; }
+    /// GL errors the caller had left pending when a dyncull call began (taken off the error
+    /// flags so they are not reported as dyncull's; see frame_contract.hpp), since creation.
+    std::uint64_t callerGlErrors() const { return callerGlErrors_; }
 
     const SceneObjects& objects() const { return objects_; }
     const LooseBsp& sceneTree() const { return tree_; }
@@ -97,6 +115,11 @@ public:
 private:
     Engine(GlContext& context, const EngineOptions& options);
     struct Sink;
+    /// Before a call's GL work: the context is current and not lost; the caller's pending
+    /// GL errors are set aside (callerGlErrors_).
+    Status enterGl(const char* what);
+    /// After it: not lost, and no GL error raised during the call.
+    Status leaveGl(const char* what);
 
     GlContext& context_;
     std::unique_ptr<Renderer> renderer_;
@@ -111,7 +134,8 @@ private:
     std::vector<std::uint8_t> hasColour_;
     DrawPartCallback callback_;
     PartObserver observer_;
-    bool finishEachFrame_ = true;
+    bool finishEachFrame_ = false;
+    std::uint64_t callerGlErrors_ = 0;
 };
 
 }  // namespace dyncull

@@ -1,7 +1,8 @@
-// An OpenGL 4.5 core context to render into: headless EGL (default) or a GLFW window. Both
-// render into an offscreen FBO with RGBA8 colour and 32-bit float depth (reversed Z needs
-// float depth; objects/camera.hpp); a window's present() copies the colour to the window.
-// The renderer only sees framebuffer() and size(), so one code path serves both.
+// An OpenGL 4.5 core context: headless EGL, a GLFW window, or a game's own context that
+// dyncull borrows. Dyncull's own contexts render into an offscreen FBO with RGBA8 colour and
+// 32-bit float depth (reversed Z needs float depth; objects/camera.hpp); a window's present()
+// copies the colour to the window. The Engine never uses the FBO: it draws into whatever
+// framebuffer and viewport are bound when it is called (engine/frame_contract.hpp).
 #pragma once
 
 #include <cstdint>
@@ -18,6 +19,7 @@ namespace dyncull {
 enum class ContextKind : std::uint8_t {
     HeadlessEgl,  ///< EGL without a surface (Mesa surfaceless / device platform), offscreen FBO
     GlfwWindow,   ///< GLFW window on an X display (or Xvfb)
+    Borrowed,     ///< the caller's context, current when GlContext::borrowCurrent was called
 };
 
 struct ContextOptions {
@@ -47,20 +49,42 @@ struct GlFaultInjection {
     std::uint32_t failBufferAllocations = 0;
 };
 
-/// Owns the native context (and, headless, its FBO). Not copyable. The context is made
-/// current on creation; GL calls must happen on the creating thread.
+/// Owns the native context (and, headless, its FBO), except when Borrowed. Not copyable.
+/// The context is made current on creation; GL calls must happen on a thread where it is
+/// current (one thread at a time, as GL itself requires).
 class GlContext {
 public:
     /// Creates and makes current. Never throws or aborts: failures come back as an Error
     /// naming every attempt, e.g. "EGL: surfaceless Mesa platform: eglInitialize failed
     /// (EGL_NOT_INITIALIZED); device platform: no devices; ...".
     static Expected<std::unique_ptr<GlContext>> create(const ContextOptions& options);
+    /// Wraps the context current on this thread, which the caller (a game) created and keeps
+    /// owning: destroying the wrapper leaves the native context, its framebuffers and its GL
+    /// state alone. framebuffer() is 0 and size() the viewport at the time of the call;
+    /// makeCurrent() and present() do nothing (the game does both). Errors: no context
+    /// current (WrongContext), or one older than OpenGL 4.5 (Unsupported).
+    static Expected<std::unique_ptr<GlContext>> borrowCurrent();
 
     virtual ~GlContext() = default;
     GlContext(const GlContext&) = delete;
     GlContext& operator=(const GlContext&) = delete;
 
     virtual void makeCurrent() = 0;
+    /// Makes no context current on this thread (dyncull's own kinds; Borrowed: nothing).
+    virtual void releaseCurrent() = 0;
+    /// True if this context is current on the calling thread. It recognises its own context
+    /// by a labelled vertex array made at creation (vertex arrays are never shared between
+    /// contexts), so it works for every kind, borrowed ones included; no context current
+    /// gives false.
+    bool isCurrent() const;
+    /// isCurrent() as a Status: "<what>: the GL context current on this thread is not the one
+    /// <...> was made on" (ErrorCode::WrongContext), so a call on the wrong context fails at
+    /// once instead of waiting on another context's queries or deleting its objects.
+    Status checkCurrent(const char* what) const;
+    /// Dyncull's own frames (demos, tests; never the Engine): binds framebuffer(), sets the
+    /// viewport to size(), and clears colour to `colour` and depth to the far plane of the
+    /// reversed-Z convention (0).
+    void clearFramebuffer(const glm::vec3& colour);
     /// Windows: copy the FBO's colour to the window, swap buffers, poll events, and follow
     /// a resize (size() and the FBO change with the window). Headless: glFlush.
     virtual void present() = 0;
@@ -87,6 +111,14 @@ public:
     /// Drains glGetError and adds the count to glErrorCount(); in debug contexts the
     /// KHR_debug callback also counts GL_DEBUG_TYPE_ERROR messages. Soak tests assert 0.
     std::uint64_t checkErrors();
+    /// At the start of a dyncull call on a borrowed frame: takes the errors the caller left
+    /// pending off the error flags, so they are not blamed on dyncull, and returns how many
+    /// there were (they are not added to glErrorCount()).
+    std::uint32_t takeCallerErrors();
+    /// At the end of a dyncull call: drains the error flags like checkErrors and, if any
+    /// was set, returns "<what> raised GL error GL_INVALID_OPERATION (0x0502) and N more"
+    /// (ErrorCode::GlError).
+    Status checkErrorsDuring(const char* what);
     std::uint64_t glErrorCount() const { return errorCount_; }
     bool isDebug() const { return debug_; }
 
@@ -110,8 +142,12 @@ protected:
     friend Expected<std::unique_ptr<GlContext>> createEglContext(const ContextOptions&);
     friend Expected<std::unique_ptr<GlContext>> createGlfwContext(const ContextOptions&);
     explicit GlContext(ContextKind kind) : kind_(kind) {}
-    /// Called by subclasses once current: queries strings, installs the debug callback.
+    /// Called by subclasses once current: queries strings, makes the fingerprint of
+    /// isCurrent(), installs the debug callback (and, for dyncull's own contexts, sets the
+    /// reversed-Z clip control and discards creation-time GL errors).
     void initCommon(bool debug);
+    /// Deletes the fingerprint (subclass destructors, with the context current).
+    void releaseCommon();
 
     ContextKind kind_;
     std::uint32_t framebuffer_ = 0;
@@ -122,6 +158,8 @@ protected:
     bool resetNotification_ = false;
     bool lost_ = false;
     std::string lostMessage_;
+    std::uint32_t fingerprint_ = 0;  // a vertex array labelled fingerprintLabel_
+    std::string fingerprintLabel_;
     GlFaultInjection faults_;
 };
 

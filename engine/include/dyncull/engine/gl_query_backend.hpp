@@ -11,6 +11,7 @@
 #include <deque>
 #include <vector>
 
+#include "dyncull/engine/frame_contract.hpp"
 #include "dyncull/objects/error.hpp"
 #include "dyncull/scheduler/query_backend.hpp"
 
@@ -37,8 +38,9 @@ struct GlQueryParams {
 };
 
 /// Owns GL query objects, a streaming vertex buffer for volumes and a depth-only program.
-/// Needs the GL context current for its whole life. Queries are issued against whatever
-/// framebuffer is bound (the renderer's) with its depth buffer.
+/// Needs its GL context current whenever it is called; destroyed with another context
+/// current, it deletes nothing (its objects die with their own context). Queries are issued
+/// against whatever framebuffer is bound, with its depth buffer.
 class GlQueryBackend final : public QueryBackend {
 public:
     static Expected<std::unique_ptr<GlQueryBackend>> create(GlContext& context, GlQueryParams params = {});
@@ -54,9 +56,14 @@ public:
     std::uint64_t samples(QueryId id) const override;
     QueryId beginDrawQuery() override;
     void endDrawQuery(QueryId id) override;
-    /// glReadPixels of the context framebuffer's depth (waits for the drawing so far);
-    /// the read framebuffer binding and pack alignment are restored.
+    /// glReadPixels of the target's depth inside its viewport (waits for the drawing so far);
+    /// false (no early depth) if no target was set or its depth cannot be read (setTarget).
+    /// The read framebuffer, pixel-pack buffer and pack parameters are restored.
     bool readDepth(std::vector<float>& depth, int& width, int& height) override;
+    /// Where readDepth reads from: the framebuffer and viewport the frame draws into (the
+    /// Engine passes the caller's, frame_contract.hpp). Queries and batched tests need no
+    /// target: they draw into whatever framebuffer is bound.
+    void setTarget(const FrameTarget& target) { target_ = target; hasTarget_ = true; }
     /// The batched raster test: one draw of all volumes into a visibility buffer, read
     /// back once its fence has signalled (batched_raster_test.cpp).
     BatchId testVolumes(std::span<const QueryVolume> volumes) override;
@@ -123,6 +130,8 @@ private:
     bool inDrawQuery_ = false;
     bool degraded_ = false;  // an allocation failed this frame: queries answer Visible
     Status frameStatus_;
+    FrameTarget target_;
+    bool hasTarget_ = false;
 };
 
 }  // namespace dyncull

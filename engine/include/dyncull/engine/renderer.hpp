@@ -11,7 +11,6 @@
 
 #include <glm/glm.hpp>
 
-#include "dyncull/engine/box_drawer.hpp"
 #include "dyncull/engine/gl_context.hpp"
 #include "dyncull/engine/image.hpp"
 #include "dyncull/objects/camera.hpp"
@@ -36,11 +35,11 @@ enum class Shading : std::uint8_t {
 struct RenderStats {
     std::uint64_t drawCalls = 0;
     std::uint64_t triangles = 0;
-    std::uint64_t boxes = 0;  ///< drawBoxDepthTestOnly calls
 };
 
 /// Owns GL buffers/programs; the GlContext it was created with must outlive it and be
-/// current whenever a method is called.
+/// current whenever a method is called. Destroyed with another context current, it deletes
+/// nothing (its objects die with their own context).
 class Renderer {
 public:
     /// Compiles the shaders. Error only if the driver rejects them.
@@ -62,10 +61,12 @@ public:
     /// GPU memory held by mesh buffers, bytes.
     std::size_t uploadedBytes() const { return uploadedBytes_; }
 
-    /// Binds the context framebuffer, sets the viewport to its full size, clears colour
-    /// and depth (to 0: reversed Z, nearer fragments win with GL_GREATER; see
-    /// objects/camera.hpp), and takes view/projection from `camera` (world space). The camera's
-    /// aspect is used as given (set it to width/height of the context).
+    /// Starts drawing into the framebuffer and viewport the caller has bound, over what they
+    /// hold (nothing is cleared; GlContext::clearFramebuffer does that for dyncull's own
+    /// frames): depth test with the reversed-Z convention (nearer fragments win with
+    /// GL_GREATER; objects/camera.hpp), depth and colour writes on, view/projection from
+    /// `camera` (world space; its aspect is used as given: set it to the viewport's).
+    /// Changes GL state without restoring it: the Engine calls it inside its state scope.
     void beginFrame(const Camera& camera);
     /// Draws indices [firstIndex, firstIndex + indexCount) of mesh `id` with object-to-world
     /// matrix `model`, in linear-ish RGB `colour` (0..1). Culls back faces if the mesh was
@@ -75,15 +76,14 @@ public:
     void drawMesh(MeshId id, const glm::mat4& model, const glm::vec3& colour) {
         drawRange(id, 0, indexCount(id), model, colour);
     }
-    /// Occlusion-query proxy: rasterises `box` (world space, or the space `model` maps to
-    /// world) against depth with colour and depth writes off.
-    void drawBoxDepthTestOnly(const Aabb& box, const glm::mat4& model = glm::mat4(1.0f));
-    /// Leaves face culling off (as beginFrame set it), flushes and counts GL errors into the context.
+    /// Leaves face culling off (as beginFrame set it) and flushes.
     void endFrame();
     /// Blocks until the GPU has finished all submitted work (for honest timings).
     void finish() const;
 
-    /// Reads the context framebuffer as a top-down RGBA8 image (waits for the GPU).
+    /// Reads the context's framebuffer (GlContext::framebuffer, its whole size) as a top-down
+    /// RGBA8 image (waits for the GPU). For dyncull's own contexts; leaves the read
+    /// framebuffer bound and the pack alignment at 1.
     Image readPixels() const;
 
     /// Lighting path of the next frames (default Shading::Vertex).
@@ -91,6 +91,10 @@ public:
     Shading shading() const { return shading_; }
     /// false draws every mesh two-sided whatever its FaceMode (to measure what culling saves).
     void setBackFaceCulling(bool honour) { cullBackFaces_ = honour; }
+    /// true runs only the vertex stage (GL_RASTERIZER_DISCARD from beginFrame to endFrame),
+    /// to measure the vertex share of a frame; nothing is drawn. With `vfc` only: occlusion
+    /// tests rasterise nothing either, so they would cull everything.
+    void setRasteriserDiscard(bool discard) { discard_ = discard; }
 
     const RenderStats& stats() const { return stats_; }
     const glm::mat4& viewProjection() const { return viewProj_; }
@@ -117,11 +121,11 @@ private:
     LitProgram programs_[2];  // indexed by Shading
     Shading shading_ = Shading::Vertex;
     bool cullBackFaces_ = true;
+    bool discard_ = false;
     bool cullEnabled_ = false, frontCcw_ = true;  // GL culling state as set in this frame (engine/src/face_culling.hpp)
     glm::mat4 viewProj_{1.0f};  // world space (box overlays); parts are drawn camera-relative
     Camera camera_;             // of the current frame, for camera-relative model matrices
     RenderStats stats_;
-    std::unique_ptr<BoxDrawer> boxes_;
 };
 
 /// A pleasant, well-separated colour for object `id` (stable hash, fixed saturation/value).
