@@ -56,6 +56,7 @@ Expected<ObjectHandle> SceneObjects::addObject(ModelId model, const Transform& t
         transform_.emplace_back();
         worldBox_.emplace_back();
         generation_.push_back(0);
+        placedAt_.push_back(0);
         alive_.push_back(0);
         static_.push_back(0);
         movedFlag_.push_back(0);
@@ -64,6 +65,7 @@ Expected<ObjectHandle> SceneObjects::addObject(ModelId model, const Transform& t
     matrix_[i] = m;
     transform_[i] = transform;
     worldBox_[i] = box;
+    placedAt_[i] = ++placements_;
     alive_[i] = 1;
     static_[i] = isStatic ? 1 : 0;
     added_.push_back(i);
@@ -89,6 +91,8 @@ Status SceneObjects::removeObject(ObjectHandle h) {
 Status SceneObjects::setTransform(ObjectHandle h, const Transform& transform) {
     if (!alive(h)) return Error{"setTransform: stale or invalid " + handleText(h)};
     const std::uint32_t i = h.index;
+    if (static_[i])
+        return Error{"setTransform: " + handleText(h) + " was added as static and never moves; remove it and add it again to move it"};
     glm::mat4 m;
     Aabb box;
     if (Status s = placement(*models_[model_[i]], transform, m, box); !s)
@@ -96,6 +100,7 @@ Status SceneObjects::setTransform(ObjectHandle h, const Transform& transform) {
     matrix_[i] = m;
     transform_[i] = transform;
     worldBox_[i] = box;
+    placedAt_[i] = ++placements_;
     if (!movedFlag_[i]) {
         movedFlag_[i] = 1;
         moved_.push_back(i);

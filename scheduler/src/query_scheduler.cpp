@@ -101,7 +101,7 @@ FrameStats QueryScheduler::cullFrame(const TwoLevelTree& tree, const Camera& cam
     const std::uint32_t slots = tree.objects().slotCount();
     if (stillSince_.size() < slots) {
         stillSince_.resize(slots, frame_);
-        lastMatrix_.resize(slots, glm::mat4(0.0f));
+        lastPlacement_.resize(slots, 0);
     }
 
     backend.beginFrame(camera, width, height);
@@ -502,9 +502,9 @@ void QueryScheduler::runQueries() {
             return false;  // no batching: one query in flight at a time
         }
         if (!ref.isSceneNode()) {
-            const glm::mat4& m = objs.matrix(ref.object);
-            if (m != lastMatrix_[ref.object]) {
-                lastMatrix_[ref.object] = m;
+            const std::uint64_t placed = objs.placedAt(ref.object);
+            if (placed != lastPlacement_[ref.object]) {
+                lastPlacement_[ref.object] = placed;
                 stillSince_[ref.object] = frame_;
             }
         }

@@ -89,3 +89,39 @@ TEST(SceneObjects, StaleHandlesAreDetectedAndSlotsReusedWithNewGeneration) {
     EXPECT_FALSE(so.removeObject(ObjectHandle{}).ok());
     EXPECT_FALSE(so.removeObject(ObjectHandle{99, 0}).ok());
 }
+
+// A static object promises never to move: setTransform refuses it and leaves it as it was.
+TEST(SceneObjects, StaticObjectsRefuseToMove) {
+    SceneObjects so;
+    const ModelId m = so.addModel(test::cubeModel());
+    const ObjectHandle s = so.addObject(m, at({1, 2, 3}), true).take();
+    const ObjectHandle d = so.addObject(m, at({0, 0, 0})).take();
+    so.clearMoved();
+    const Status st = so.setTransform(s, at({5, 5, 5}));
+    ASSERT_FALSE(st.ok());
+    EXPECT_EQ(st.code(), ErrorCode::BadArgument);
+    EXPECT_NE(st.message().find("static"), std::string::npos) << st.message();
+    EXPECT_EQ(so.transform(s.index).translation, glm::vec3(1, 2, 3));
+    EXPECT_TRUE(so.moved().empty());
+    EXPECT_TRUE(so.setTransform(d, at({5, 5, 5})).ok());
+}
+
+// placedAt changes with every placement and with the reuse of a slot, never otherwise.
+TEST(SceneObjects, PlacementSerialsMarkMovesAndSlotReuse) {
+    SceneObjects so;
+    const ModelId m = so.addModel(test::cubeModel());
+    const ObjectHandle a = so.addObject(m, at({0, 0, 0})).take();
+    const ObjectHandle b = so.addObject(m, at({1, 0, 0})).take();
+    const std::uint64_t a0 = so.placedAt(a.index), b0 = so.placedAt(b.index);
+    EXPECT_NE(a0, b0);
+    ASSERT_TRUE(so.setTransform(a, at({0, 1, 0})).ok());
+    EXPECT_GT(so.placedAt(a.index), b0);
+    EXPECT_EQ(so.placedAt(b.index), b0);
+    const std::uint64_t a1 = so.placedAt(a.index);
+    ASSERT_FALSE(so.setTransform(a, at({std::nanf(""), 0, 0})).ok());  // refused: no new placement
+    EXPECT_EQ(so.placedAt(a.index), a1);
+    ASSERT_TRUE(so.removeObject(b).ok());
+    const ObjectHandle c = so.addObject(m, at({1, 0, 0})).take();  // same slot, same place, new object
+    ASSERT_EQ(c.index, b.index);
+    EXPECT_NE(so.placedAt(c.index), b0);
+}

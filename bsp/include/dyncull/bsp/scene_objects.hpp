@@ -35,10 +35,13 @@ public:
     const LocalBsp& model(ModelId id) const { return *models_[id]; }
     std::size_t modelCount() const { return models_.size(); }
 
-    /// Adds an instance. Errors on an unknown model or an invalid transform.
+    /// Adds an instance. Errors on an unknown model or an invalid transform. A static object
+    /// promises never to move: setTransform refuses it, and it costs nothing per frame (no
+    /// relink, no motion check anywhere downstream).
     Expected<ObjectHandle> addObject(ModelId model, const Transform& transform, bool isStatic = false);
     Status removeObject(ObjectHandle h);
-    /// Sets a new world transform; marks the object moved for this frame's relink.
+    /// Sets a new world transform; marks the object moved for this frame's relink. Errors:
+    /// stale handle, invalid transform, or a static object.
     Status setTransform(ObjectHandle h, const Transform& transform);
     bool alive(ObjectHandle h) const;
 
@@ -51,6 +54,10 @@ public:
     const Transform& transform(std::uint32_t i) const { return transform_[i]; }
     const Aabb& worldBox(std::uint32_t i) const { return worldBox_[i]; }  ///< world space
     bool isStatic(std::uint32_t i) const { return static_[i] != 0; }
+    /// When the slot was last placed (addObject or setTransform), as a value of one counter
+    /// shared by every slot: a consumer that keeps it sees a move, or the slot's reuse by a
+    /// new object, as a different value, without comparing matrices.
+    std::uint64_t placedAt(std::uint32_t i) const { return placedAt_[i]; }
     ObjectHandle handle(std::uint32_t i) const { return {i, generation_[i]}; }
 
     /// Slots whose transform changed since the last clearMoved() (unique, ascending not guaranteed).
@@ -68,6 +75,8 @@ private:
     std::vector<Transform> transform_;
     std::vector<Aabb> worldBox_;
     std::vector<std::uint32_t> generation_;
+    std::vector<std::uint64_t> placedAt_;
+    std::uint64_t placements_ = 0;
     std::vector<std::uint8_t> alive_, static_, movedFlag_;
     std::vector<std::uint32_t> freeSlots_, moved_, added_, removed_;
     std::uint32_t live_ = 0;

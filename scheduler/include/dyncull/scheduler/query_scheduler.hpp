@@ -238,7 +238,7 @@ private:
     std::uint32_t frame_ = 0;
     std::uint32_t frontBudget_ = 0, frontLeavesSeen_ = 0;  // frontPercent, this frame
     std::vector<std::uint32_t> stillSince_;  // per object slot: first frame of its current transform (seen lazily)
-    std::vector<glm::mat4> lastMatrix_;
+    std::vector<std::uint64_t> lastPlacement_;  // per object slot: SceneObjects::placedAt when last seen
 
     // Per-frame borrowed state.
     const TwoLevelTree* tree_ = nullptr;
