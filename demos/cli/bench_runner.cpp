@@ -306,7 +306,7 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
     ft.frustumParts = truth_.candidates;
     ft.coveredPixels = truth_.coveredPixels;
     ft.artefactPixels = truth_.artefactPixels;
-    for (const PartKey& k : truth_.parts) ft.visibleTriangles += engine_.objects().model(engine_.objects().modelOf(k.object)).nodes[k.node].indexCount / 3;
+    for (const NodeRef& k : truth_.parts) ft.visibleTriangles += engine_.objects().model(engine_.objects().modelOf(k.object)).nodes[k.node].indexCount / 3;
 
     // The oracle draws the visible parts front-to-back like the other modes, so it gets
     // the same early-depth rejection and is a fair lower bound.
@@ -314,7 +314,7 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
     const glm::vec3 eye = engine_.camera().position;
     std::vector<std::pair<float, NodeRef>> byDistance;
     byDistance.reserve(truth_.parts.size());
-    for (const PartKey& k : truth_.parts) {
+    for (const NodeRef& k : truth_.parts) {
         const NodeRef ref{k.object, k.node};
         const glm::vec3 d = tree.worldBox(ref).center() - eye;
         byDistance.push_back({glm::dot(d, d), ref});
@@ -323,10 +323,6 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
     oracleParts_.clear();
     for (const auto& p : byDistance) oracleParts_.push_back(p.second);
 
-    const SceneObjects& objects = engine_.objects();
-    engine_.setPartObserver([this, &objects](std::uint32_t object, std::uint32_t first, std::uint32_t count) {
-        recorder_.record(objects, object, first, count);
-    });
     std::vector<ModeFrame> row(result_.modes.size());
     // vfc first (its image is the reference), the others in an order rotated every frame:
     // the mode right after vfc ran measurably slower on llvmpipe (docs/BENCHMARKS.md), so
@@ -336,21 +332,18 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
         const std::size_t m = k == 0 ? 0 : 1 + (k - 1 + turn) % (n - 1);
         const ModeSpec& spec = result_.modes[m];
         engine_.setQueryParams(spec.queries);
-        recorder_.clear();
         if (schedulers_[m]) schedulers_[m]->setTrace(&trace_);
         engine_.context().clearFramebuffer(Renderer::kClearColour);
         auto rendered = spec.oracle ? engine_.renderParts(oracleParts_) : engine_.renderFrame(*schedulers_[m]);
         if (schedulers_[m]) schedulers_[m]->setTrace(nullptr);
         if (!rendered) {
-            engine_.setPartObserver(nullptr);
             return Error{"frame " + std::to_string(frame) + ", mode " + spec.name + ": " + rendered.error().message};
         }
         row[m].stats = *rendered;
-        row[m].parts = compareParts(truth_, recorder_.drawn());
+        row[m].parts = compareParts(truth_, drawnLeaves(engine_.objects(), engine_.visibleParts()));
         images_[m] = engine_.renderer().readPixels();
         auto diff = compareImages(images_[m], images_[0]);
         if (!diff) {
-            engine_.setPartObserver(nullptr);
             return Error{diff.error().message};
         }
         row[m].image = *diff;
@@ -362,7 +355,6 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
             ft.boundAuto = volumeBound(VolumeChoice::Auto);
         }
     }
-    engine_.setPartObserver(nullptr);
     result_.truth.push_back(ft);
     result_.frames.push_back(std::move(row));
     return {};
@@ -373,7 +365,7 @@ FalsePositiveCauses BenchRunner::falsePositiveCauses() const {
     FalsePositiveCauses c;
     const TwoLevelTree tree(engine_.sceneTree(), engine_.objects());
     for (const NodeTrace& t : trace_) {
-        if (t.ref.isSceneNode() || !tree.isDrawable(t.ref) || truth_.contains(PartKey{t.ref.object, t.ref.node})) continue;
+        if (t.ref.isSceneNode() || !tree.isDrawable(t.ref) || truth_.contains(NodeRef{t.ref.object, t.ref.node})) continue;
         switch (t.state) {
             case NodeState::FrustumCulled:
             case NodeState::Occluded:

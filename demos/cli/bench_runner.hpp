@@ -141,7 +141,6 @@ private:
     DemoScene& scene_;
     std::unique_ptr<GroundTruth> groundTruth_;
     std::vector<std::unique_ptr<QueryScheduler>> schedulers_;  // per mode; null for the oracle
-    DrawnPartRecorder recorder_;
     BenchResult result_;
     VisibleSet truth_;
     std::vector<Image> images_;

@@ -12,12 +12,18 @@ namespace dyncull {
 struct Engine::Sink final : PartSink {
     Engine& e;
     explicit Sink(Engine& engine) : e(engine) {}
-    void drawPart(std::uint32_t object, std::uint32_t firstIndex, std::uint32_t indexCount) override {
+    void drawPart(NodeRef part, std::uint32_t firstIndex, std::uint32_t indexCount) override {
         const SceneObjects& objs = e.objects_;
-        if (e.observer_) e.observer_(object, firstIndex, indexCount);
+        const std::uint32_t object = part.object;
+        const ObjectHandle handle = objs.handle(object);
+        e.visibleParts_.push_back({handle, part, firstIndex, indexCount});
+        if (e.visibleFrame_[object] != e.frameSerial_) {
+            e.visibleFrame_[object] = e.frameSerial_;
+            e.visibleObjects_.push_back(handle);
+        }
         const ModelId model = objs.modelOf(object);
         if (e.callback_) {
-            e.callback_(objs.handle(object), model, firstIndex, indexCount, objs.matrix(object));
+            e.callback_(handle, model, firstIndex, indexCount, objs.matrix(object));
             return;
         }
         const glm::vec3 colour = object < e.hasColour_.size() && e.hasColour_[object] ? e.colour_[object] : colourForId(object);
@@ -109,6 +115,21 @@ void Engine::setColour(ObjectHandle object, const glm::vec3& colour) {
     hasColour_[object.index] = 1;
 }
 
+void Engine::beginVisibleLists() {
+    ++frameSerial_;
+    if (frameSerial_ == 0) {  // wrapped after 2^32 frames: no slot may look drawn this frame
+        std::fill(visibleFrame_.begin(), visibleFrame_.end(), 0u);
+        frameSerial_ = 1;
+    }
+    visibleFrame_.resize(objects_.slotCount(), 0);
+    visibleParts_.clear();
+    visibleObjects_.clear();
+}
+
+bool Engine::isVisible(ObjectHandle object) const {
+    return objects_.alive(object) && object.index < visibleFrame_.size() && visibleFrame_[object.index] == frameSerial_;
+}
+
 LooseBspFrameStats Engine::updateSceneTree() {
     if (!treeBuilt_) {
         const auto t0 = std::chrono::steady_clock::now();
@@ -122,6 +143,7 @@ LooseBspFrameStats Engine::updateSceneTree() {
 }
 
 Expected<FrameStats> Engine::renderFrame(QueryScheduler& scheduler) {
+    beginVisibleLists();  // a refused frame draws nothing
     if (Status s = enterGl("renderFrame"); !s) return s.error();
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();
@@ -146,6 +168,7 @@ Expected<FrameStats> Engine::renderFrame(QueryScheduler& scheduler) {
 }
 
 Expected<FrameStats> Engine::renderParts(const std::vector<NodeRef>& parts) {
+    beginVisibleLists();
     if (Status s = enterGl("renderParts"); !s) return s.error();
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();
@@ -160,7 +183,7 @@ Expected<FrameStats> Engine::renderParts(const std::vector<NodeRef>& parts) {
         const LocalBsp& bsp = objects_.model(objects_.modelOf(ref.object));
         assert(ref.node < bsp.nodes.size());
         const LocalBspNode& n = bsp.nodes[ref.node];
-        sink.drawPart(ref.object, n.firstIndex, n.indexCount);
+        sink.drawPart(ref, n.firstIndex, n.indexCount);
         ++st.partsDrawn;
         st.trianglesDrawn += n.indexCount / 3;
     }

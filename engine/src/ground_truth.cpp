@@ -65,7 +65,7 @@ glm::vec2 GroundTruth::windowDepthRange(const SceneObjects& objects, NodeRef ref
     return {static_cast<float>(lo - slack), static_cast<float>(hi + slack)};
 }
 
-std::uint32_t VisibleSet::pixelsOf(PartKey key) const {
+std::uint32_t VisibleSet::pixelsOf(NodeRef key) const {
     const auto it = std::lower_bound(parts.begin(), parts.end(), key);
     if (it == parts.end() || !(*it == key)) return 0;
     return pixels[static_cast<std::size_t>(it - parts.begin())];
@@ -232,39 +232,22 @@ VisibleSet GroundTruth::compute(const SceneObjects& objects, const Camera& camer
     return vs;
 }
 
-void DrawnPartRecorder::record(const SceneObjects& objects, std::uint32_t object, std::uint32_t firstIndex,
-                               std::uint32_t indexCount) {
-    const ModelId model = objects.modelOf(object);
-    if (leaves_.size() <= model) leaves_.resize(model + 1);
-    std::vector<LeafStart>& leaves = leaves_[model];
-    const LocalBsp& bsp = objects.model(model);
-    if (leaves.empty()) {
-        // Depth-first node order keeps leaf ranges ascending; empty leaves own no pixels.
-        for (std::uint32_t i = 0; i < bsp.nodes.size(); ++i)
-            if (bsp.nodes[i].isLeaf() && (bsp.nodes[i].indexCount > 0 || bsp.nodes.size() == 1))
-                leaves.push_back({bsp.nodes[i].firstIndex, i});
+std::vector<NodeRef> drawnLeaves(const SceneObjects& objects, std::span<const VisiblePart> parts) {
+    std::vector<NodeRef> leaves;
+    for (const VisiblePart& p : parts) {
+        const LocalBsp& bsp = objects.model(objects.modelOf(p.part.object));
+        // Depth-first storage: the subtree of node n is nodes [n, n + subtreeSize).
+        const std::uint32_t first = p.part.node, end = first + bsp.nodes[first].subtreeSize;
+        for (std::uint32_t n = first; n < end; ++n)
+            if (bsp.nodes[n].isLeaf() && (bsp.nodes[n].indexCount > 0 || bsp.nodes.size() == 1))
+                leaves.push_back({p.part.object, n});  // empty leaves own no pixels
     }
-    // Every leaf whose range starts inside the drawn range (a leaf, or a whole subtree).
-    auto it = std::lower_bound(leaves.begin(), leaves.end(), firstIndex,
-                               [](const LeafStart& l, std::uint32_t v) { return l.firstIndex < v; });
-    const std::uint64_t end = static_cast<std::uint64_t>(firstIndex) + indexCount;
-    for (; it != leaves.end() && (it->firstIndex < end || (indexCount == 0 && it->firstIndex == firstIndex)); ++it) {
-        if (drawn_.size() && sorted_ && !(drawn_.back() < PartKey{object, it->node})) sorted_ = false;
-        drawn_.push_back({object, it->node});
-        if (indexCount == 0) break;
-    }
+    std::sort(leaves.begin(), leaves.end());
+    leaves.erase(std::unique(leaves.begin(), leaves.end()), leaves.end());
+    return leaves;
 }
 
-const std::vector<PartKey>& DrawnPartRecorder::drawn() {
-    if (!sorted_) {
-        std::sort(drawn_.begin(), drawn_.end());
-        drawn_.erase(std::unique(drawn_.begin(), drawn_.end()), drawn_.end());
-        sorted_ = true;
-    }
-    return drawn_;
-}
-
-PartErrors compareParts(const VisibleSet& truth, const std::vector<PartKey>& drawn) {
+PartErrors compareParts(const VisibleSet& truth, const std::vector<NodeRef>& drawn) {
     PartErrors e;
     e.drawn = static_cast<std::uint32_t>(drawn.size());
     std::size_t i = 0, j = 0;  // merge of two sorted lists

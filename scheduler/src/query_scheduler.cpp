@@ -294,14 +294,14 @@ void QueryScheduler::drawNode(NodeRef ref, bool untested) {
     const auto t0 = Clock::now();
     if (untested && params_.mode == CullMode::Queries && params_.useDrawQueries) {
         const QueryId id = backend_->beginDrawQuery();
-        sink_->drawPart(ref.object, n.firstIndex, n.indexCount);
+        sink_->drawPart(ref, n.firstIndex, n.indexCount);
         if (id != kNoQuery) {
             backend_->endDrawQuery(id);
             drawQueries_.push_back(pendingOf(ref, id, {}, false));
             ++stats_->drawQueries;
         }
     } else {
-        sink_->drawPart(ref.object, n.firstIndex, n.indexCount);
+        sink_->drawPart(ref, n.firstIndex, n.indexCount);
     }
     stats_->drawMs += msSince(t0);
     ++stats_->partsDrawn;

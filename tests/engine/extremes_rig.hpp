@@ -1,5 +1,5 @@
 // Shared rig of the numerical-extremes tests: an engine with a vfc and a conservative full
-// scheduler, the ID-pass ground truth and a drawn-part recorder, rendering one frame with
+// scheduler, the ID-pass ground truth, rendering one frame with
 // each scheduler and comparing images and parts.
 #pragma once
 
@@ -18,7 +18,7 @@ namespace dyncull::test {
 inline constexpr int kWidth = 160, kHeight = 120;
 
 /// An engine with a vfc scheduler and the two conservative occlusion modes (full, which is
-/// two-phase, and queries), the ground truth, and a drawn-part recorder.
+/// two-phase, and queries) and the ground truth.
 struct Rig {
     std::unique_ptr<GlContext> ctx;
     std::unique_ptr<Engine> engine;
@@ -42,7 +42,6 @@ struct Rig {
         p.useCostModel = false;
         return p;
     }()};
-    DrawnPartRecorder recorder;
 
     Rig() {
         ctx = headless(kWidth, kHeight);
@@ -53,9 +52,6 @@ struct Rig {
         auto t = GroundTruth::create(*ctx);
         EXPECT_TRUE(t.ok());
         truth = t.take();
-        engine->setPartObserver([this](std::uint32_t o, std::uint32_t first, std::uint32_t count) {
-            recorder.record(engine->objects(), o, first, count);
-        });
     }
     bool ok() const { return engine && truth; }
     ModelId model(const Mesh& m, const LocalBspParams& params = {}) {
@@ -77,7 +73,8 @@ struct Rig {
         ImageDiff diff, fullDiff;          // queries and full against vfc
         PartErrors errors, fullErrors;     // queries and full against the ground truth
         FrameStats vfcStats, queriesStats, fullStats;
-        std::vector<PartKey> fullDrawn;    // the parts full drew (queries': recorder.drawn())
+        std::vector<NodeRef> fullDrawn;     // the leaves full drew (drawnLeaves)
+        std::vector<NodeRef> queriesDrawn;  // the leaves queries drew
         std::uint32_t visibleParts = 0;
     };
     /// One frame with vfc and queries from `camera`; full renders two, since it decides
@@ -91,15 +88,14 @@ struct Rig {
         r.vfcImage = engine->renderer().readPixels();
         ctx->clearFramebuffer(Renderer::kClearColour);
         EXPECT_TRUE(engine->renderFrame(full).ok());
-        recorder.clear();
         ctx->clearFramebuffer(Renderer::kClearColour);
         r.fullStats = *engine->renderFrame(full);
         r.fullImage = engine->renderer().readPixels();
-        r.fullDrawn = recorder.drawn();
-        recorder.clear();
+        r.fullDrawn = drawnLeaves(engine->objects(), engine->visibleParts());
         ctx->clearFramebuffer(Renderer::kClearColour);
         r.queriesStats = *engine->renderFrame(queries);
         r.queriesImage = engine->renderer().readPixels();
+        r.queriesDrawn = drawnLeaves(engine->objects(), engine->visibleParts());
         auto d = compareImages(r.vfcImage, r.queriesImage);
         auto f = compareImages(r.vfcImage, r.fullImage);
         EXPECT_TRUE(d.ok() && f.ok());
@@ -107,7 +103,7 @@ struct Rig {
         r.fullDiff = *f;
         const VisibleSet vis = truth->compute(*engine, camera);
         r.visibleParts = static_cast<std::uint32_t>(vis.parts.size());
-        r.errors = compareParts(vis, recorder.drawn());
+        r.errors = compareParts(vis, r.queriesDrawn);
         r.fullErrors = compareParts(vis, r.fullDrawn);
         EXPECT_EQ(ctx->checkErrors(), 0u);
         return r;

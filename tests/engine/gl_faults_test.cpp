@@ -30,7 +30,6 @@ struct FaultRig : ::testing::Test {
     std::unique_ptr<GlContext> ctx = headless();
     std::unique_ptr<Engine> engine;
     ModelId quadModel = 0, cubeModel = 0;
-    std::uint32_t partsThisFrame = 0;
 
     void SetUp() override {
         ASSERT_TRUE(ctx);
@@ -47,11 +46,9 @@ struct FaultRig : ::testing::Test {
         ASSERT_TRUE(engine->addObject(quadModel, at({0, 0, 0})).ok());
         ASSERT_TRUE(engine->addObject(cubeModel, at({0, 0, -2})).ok());  // right behind the quad
         ASSERT_TRUE(engine->setCamera(cameraOnZ(3.0f)).ok());
-        engine->setPartObserver([this](std::uint32_t, std::uint32_t, std::uint32_t) { ++partsThisFrame; });
     }
 
     Expected<FrameStats> frame() {
-        partsThisFrame = 0;
         ctx->clearFramebuffer(Renderer::kClearColour);
         return engine->renderFrame();
     }
@@ -118,7 +115,7 @@ TEST_F(FaultRig, FailedUploadLeavesTheEngineAsBefore) {
 
 TEST_F(FaultRig, QueryBufferOutOfMemoryCountsEveryQueryVisibleForOneFrame) {
     ASSERT_TRUE(frame().ok());
-    ASSERT_EQ(partsThisFrame, 1u);
+    ASSERT_EQ(engine->visibleParts().size(), 1u);
     // The frame's first allocation is the orphaning of the volume vertex buffer.
     ctx->faultInjectionForTesting().failBufferAllocations = 1;
     auto st = frame();
@@ -126,7 +123,7 @@ TEST_F(FaultRig, QueryBufferOutOfMemoryCountsEveryQueryVisibleForOneFrame) {
     EXPECT_TRUE(contains(st.error().message, "query backend: out of GPU memory orphaning the query volume vertex buffer ("))
         << st.error().message;
     EXPECT_TRUE(contains(st.error().message, "queries counted visible")) << st.error().message;
-    EXPECT_EQ(partsThisFrame, 2u);  // nothing culled: the hidden cube is drawn too
+    EXPECT_EQ(engine->visibleParts().size(), 2u);  // nothing culled: the hidden cube is drawn too
     EXPECT_FALSE(engine->queryBackend().frameStatus().ok());
     // The next frame allocates again and culls as before.
     st = frame();
@@ -161,7 +158,7 @@ TEST_F(FaultRig, ContextLostBetweenFramesIsAnErrorFromThenOn) {
     ASSERT_FALSE(st.ok());
     const std::string message = st.error().message;
     EXPECT_EQ(message, "OpenGL context lost (innocent reset: another context caused it); recreate the GlContext and the Engine");
-    EXPECT_EQ(partsThisFrame, 0u);  // refused before any GL work
+    EXPECT_EQ(engine->visibleParts().size(), 0u);  // refused before any GL work
     EXPECT_TRUE(ctx->lost());
     // Sticky even if the driver stopped saying so: every later GL-using call gives the same error.
     ctx->faultInjectionForTesting().simulateReset = ResetKind::None;

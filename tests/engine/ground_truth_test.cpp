@@ -1,6 +1,6 @@
 // Ground truth by the ID pass on hand-made scenes: hidden parts are not visible, pixel
 // counts add up to the covered pixels, and coverage matches the renderer's own image
-// pixel for pixel. Also the drawn-part recorder and the part comparison.
+// pixel for pixel. Also the drawn leaves, the per-object answers and the part comparison.
 #include <gtest/gtest.h>
 
 #include <glm/gtc/quaternion.hpp>
@@ -70,7 +70,7 @@ TEST_F(QuadAndCube, HiddenCubeIsNotVisible) {
     const VisibleSet vs = truth->compute(*engine, engine->camera());
     EXPECT_EQ(vs.candidates, 2u);  // the far cube is frustum-culled
     ASSERT_EQ(vs.parts.size(), 1u);
-    EXPECT_EQ(vs.parts[0], (PartKey{quad.index, 0}));
+    EXPECT_EQ(vs.parts[0], (NodeRef{quad.index, 0}));
     EXPECT_FALSE(vs.contains({cube.index, 0}));
     EXPECT_EQ(vs.pixelsOf({cube.index, 0}), 0u);
     EXPECT_EQ(vs.pixels[0], vs.coveredPixels);
@@ -107,14 +107,9 @@ TEST_F(QuadAndCube, MirroredCulledCubeIsSeenAsTheRendererDrawsIt) {
 
 TEST_F(QuadAndCube, DrawnPartsAreComparedWithTheTruth) {
     const VisibleSet vs = truth->compute(*engine, engine->camera());
-    DrawnPartRecorder rec;
-    engine->setPartObserver([&](std::uint32_t o, std::uint32_t first, std::uint32_t count) {
-        rec.record(engine->objects(), o, first, count);
-    });
     ctx->clearFramebuffer(Renderer::kClearColour);
     ASSERT_TRUE(engine->renderFrame().ok());  // vfc draws quad and hidden cube
-    engine->setPartObserver(nullptr);
-    const PartErrors e = compareParts(vs, rec.drawn());
+    const PartErrors e = compareParts(vs, drawnLeaves(engine->objects(), engine->visibleParts()));
     EXPECT_EQ(e.drawn, 2u);
     EXPECT_EQ(e.falseNegatives, 0u);
     EXPECT_EQ(e.falsePositives, 1u);
@@ -124,8 +119,21 @@ TEST_F(QuadAndCube, DrawnPartsAreComparedWithTheTruth) {
     // The oracle path draws exactly the visible set and gives the same picture as vfc.
     const Image vfcImage = engine->renderer().readPixels();
     ctx->clearFramebuffer(Renderer::kClearColour);
+    // The per-object answers of that frame: quad and cube drawn, the far cube culled.
+    EXPECT_TRUE(engine->isVisible(quad));
+    EXPECT_TRUE(engine->isVisible(cube));
+    EXPECT_FALSE(engine->isVisible(faraway));
+    EXPECT_EQ(engine->visibleObjects().size(), 2u);
     const FrameStats st = *engine->renderParts({{quad.index, 0}});
     EXPECT_EQ(st.partsDrawn, 1u);
+    ASSERT_EQ(engine->visibleObjects().size(), 1u);
+    EXPECT_EQ(engine->visibleObjects()[0], quad);
+    EXPECT_FALSE(engine->isVisible(cube));
+    ASSERT_EQ(engine->visibleParts().size(), 1u);
+    EXPECT_EQ(engine->visibleParts()[0].part, (NodeRef{quad.index, 0}));
+    // A removed object is not visible, and its stale handle never will be.
+    ASSERT_TRUE(engine->removeObject(quad).ok());
+    EXPECT_FALSE(engine->isVisible(quad));
     EXPECT_EQ(engine->renderer().readPixels().rgba, vfcImage.rgba);
     EXPECT_EQ(ctx->checkErrors(), 0u);
 }
@@ -155,7 +163,7 @@ TEST(GroundTruthArtefacts, FragmentsOutsideTheirBoxDepthRangeAreNotCounted) {
     ASSERT_TRUE(engine->setCamera(cameraOnZ(4.0f)).ok());
     const VisibleSet vs = truth->compute(*engine, engine->camera());
     ASSERT_EQ(vs.parts.size(), 1u);
-    EXPECT_EQ(vs.parts[0], (PartKey{a.index, 0}));
+    EXPECT_EQ(vs.parts[0], (NodeRef{a.index, 0}));
     EXPECT_FALSE(vs.contains({b.index, 0}));
     // The two quads are mirror images on screen, so the artefacts are about as many
     // pixels as the honest quad owns.
@@ -168,7 +176,7 @@ TEST(GroundTruthArtefacts, FragmentsOutsideTheirBoxDepthRangeAreNotCounted) {
     }
 }
 
-TEST(DrawnPartRecorder, RangesMapToTheLeavesTheyCover) {
+TEST(DrawnLeaves, PartsMapToTheLeavesTheyCover) {
     SceneObjects objects;
     LocalBspParams p;
     p.maxLeafTriangles = 40;
@@ -184,14 +192,15 @@ TEST(DrawnPartRecorder, RangesMapToTheLeavesTheyCover) {
             someLeaf = i;
         }
     ASSERT_GT(leaves, 4u);
-    DrawnPartRecorder rec;
-    rec.record(objects, h.index, b.nodes[someLeaf].firstIndex, b.nodes[someLeaf].indexCount);
-    ASSERT_EQ(rec.drawn().size(), 1u);
-    EXPECT_EQ(rec.drawn()[0], (PartKey{h.index, someLeaf}));
-    rec.clear();
-    rec.record(objects, h.index, b.root().firstIndex, b.root().indexCount);  // whole subtree
-    rec.record(objects, h.index, b.nodes[someLeaf].firstIndex, b.nodes[someLeaf].indexCount);  // duplicate
-    EXPECT_EQ(rec.drawn().size(), leaves);
+    auto part = [&](std::uint32_t node) {
+        return VisiblePart{h, NodeRef{h.index, node}, b.nodes[node].firstIndex, b.nodes[node].indexCount};
+    };
+    const std::vector<VisiblePart> one = {part(someLeaf)};
+    const std::vector<NodeRef> leafOnly = drawnLeaves(objects, one);
+    ASSERT_EQ(leafOnly.size(), 1u);
+    EXPECT_EQ(leafOnly[0], (NodeRef{h.index, someLeaf}));
+    const std::vector<VisiblePart> rootAndLeaf = {part(0), part(someLeaf)};  // a whole subtree, and a duplicate
+    EXPECT_EQ(drawnLeaves(objects, rootAndLeaf).size(), leaves);
 }
 
 }  // namespace

@@ -143,7 +143,7 @@ struct NearFarScene {
                     partAt[i] = static_cast<std::uint32_t>(partOfId.size());
                 }
         }
-        std::map<PartKey, std::uint32_t> pixels;
+        std::map<NodeRef, std::uint32_t> pixels;
         for (std::uint32_t id : partAt)
             if (id != 0) ++pixels[{partOfId[id - 1].object, partOfId[id - 1].node}];
         for (const auto& [key, n] : pixels) {
@@ -166,10 +166,10 @@ TEST(NearFar, NearPlane1eMinus4WithFarPlane1e7MatchesTheLayeredReference) {
     auto fullImgVsRef = compareImages(ref.image, r.queriesImage);
     ASSERT_TRUE(vfcVsRef.ok() && fullImgVsRef.ok());
     const PartErrors truthVsRef = compareParts(ref.visible, truth.parts);
-    const PartErrors fullPartsVsRef = compareParts(ref.visible, scene.rig.recorder.drawn());
+    const PartErrors fullPartsVsRef = compareParts(ref.visible, r.queriesDrawn);
     std::uint32_t hiddenDrawn = 0, hiddenObjects = 0;
     std::set<std::uint32_t> drawnObjects;
-    for (const PartKey& k : scene.rig.recorder.drawn()) drawnObjects.insert(k.object);
+    for (const NodeRef& k : r.queriesDrawn) drawnObjects.insert(k.object);
     for (const auto& p : scene.placed)
         if (p.hidden) {
             ++hiddenObjects;
@@ -186,7 +186,7 @@ TEST(NearFar, NearPlane1eMinus4WithFarPlane1e7MatchesTheLayeredReference) {
 
     // The scene is what it claims: every object not hidden by construction shows, no hidden one does.
     std::set<std::uint32_t> refObjects;
-    for (const PartKey& k : ref.visible.parts) refObjects.insert(k.object);
+    for (const NodeRef& k : ref.visible.parts) refObjects.insert(k.object);
     for (const auto& p : scene.placed)
         EXPECT_EQ(refObjects.count(p.handle.index), p.hidden ? 0u : 1u) << p.what << " at layer " << p.layer;
 
@@ -207,7 +207,7 @@ TEST(NearFar, NearPlane1eMinus4WithFarPlane1e7MatchesTheLayeredReference) {
     EXPECT_LE(twoPhaseVsRef->percentDiffering, 0.01);
     EXPECT_EQ(compareParts(ref.visible, r.fullDrawn).falseNegatives, 0u);
     std::set<std::uint32_t> twoPhaseObjects;
-    for (const PartKey& k : r.fullDrawn) twoPhaseObjects.insert(k.object);
+    for (const NodeRef& k : r.fullDrawn) twoPhaseObjects.insert(k.object);
     for (const auto& p : scene.placed)
         if (p.hidden) {
             EXPECT_EQ(twoPhaseObjects.count(p.handle.index), 0u) << "full drew hidden " << p.what;

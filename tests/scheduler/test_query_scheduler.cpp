@@ -79,7 +79,7 @@ SchedulerParams queriesParams() {
 
 struct RecordingSink final : PartSink {
     std::multiset<std::uint32_t> drawn;
-    void drawPart(std::uint32_t object, std::uint32_t, std::uint32_t) override { drawn.insert(object); }
+    void drawPart(NodeRef part, std::uint32_t, std::uint32_t) override { drawn.insert(part.object); }
 };
 
 // Answers by a rule after `latency` polls; can also never answer.
@@ -624,9 +624,9 @@ struct ForwardingSink final : PartSink {
     DrawQueryBackend& backend;
     std::multiset<std::uint32_t> drawn;
     explicit ForwardingSink(DrawQueryBackend& b) : backend(b) {}
-    void drawPart(std::uint32_t object, std::uint32_t, std::uint32_t) override {
-        drawn.insert(object);
-        backend.lastDrawn = object;
+    void drawPart(NodeRef part, std::uint32_t, std::uint32_t) override {
+        drawn.insert(part.object);
+        backend.lastDrawn = part.object;
     }
 };
 

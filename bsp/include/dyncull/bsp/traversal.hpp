@@ -22,6 +22,10 @@ struct NodeRef {
     std::uint32_t node = kInvalidIndex;
     bool isSceneNode() const { return object == kInvalidIndex; }
     friend bool operator==(const NodeRef&, const NodeRef&) = default;
+    /// By object slot, then node (the order of visible sets and drawn-part lists).
+    friend bool operator<(const NodeRef& a, const NodeRef& b) {
+        return a.object != b.object ? a.object < b.object : a.node < b.node;
+    }
 };
 
 /// A mixed 32-bit hash of a node (multiplicative, per field), for spreading per-node work

@@ -6,6 +6,7 @@
 
 #include <functional>
 #include <memory>
+#include <span>
 #include <string>
 
 #include "dyncull/bsp/local_bsp.hpp"
@@ -37,9 +38,14 @@ using DrawPartCallback =
     std::function<void(ObjectHandle object, ModelId model, std::uint32_t firstIndex, std::uint32_t indexCount,
                        const glm::mat4& objectToWorld)>;
 
-/// Told about every part drawn, before it is drawn (whoever draws it): object slot and the
-/// index range of its model's split mesh. For measurement (which parts a mode drew).
-using PartObserver = std::function<void(std::uint32_t object, std::uint32_t firstIndex, std::uint32_t indexCount)>;
+/// A part drawn in the last frame, which in a conservative mode is every visible part (and
+/// perhaps some hidden ones).
+struct VisiblePart {
+    ObjectHandle object;   ///< the object, as addObject returned it
+    NodeRef part;          ///< object slot and local-BSP node: a leaf, or an inner node drawn whole
+    std::uint32_t firstIndex = 0;  ///< the node's range of the model's split mesh (Engine::model(id).mesh.indices)
+    std::uint32_t indexCount = 0;
+};
 
 /// Borrows the GL context, which must outlive the Engine (a game's own context is wrapped
 /// with GlContext::borrowCurrent). Each frame it draws into the framebuffer and viewport the
@@ -93,8 +99,15 @@ public:
     /// no culling and no queries, timed like renderFrame (the oracle lower bound of `dyncull
     /// bench`). Every ref must name a live object and a node of its model. Errors: context lost.
     Expected<FrameStats> renderParts(const std::vector<NodeRef>& parts);
-    /// Observer of drawn parts (nullptr removes it); see PartObserver.
-    void setPartObserver(PartObserver observer) { observer_ = std::move(observer); }
+    /// The parts the last renderFrame or renderParts drew, in the order drawn (front to back
+    /// within each pass); empty after a frame that returned an error before drawing. Valid
+    /// until the next frame.
+    std::span<const VisiblePart> visibleParts() const { return visibleParts_; }
+    /// The objects with a part among visibleParts(), each once, in the order of their first
+    /// part: what a game that draws whole objects draws (conservative modes miss none).
+    std::span<const ObjectHandle> visibleObjects() const { return visibleObjects_; }
+    /// True if `object` is among visibleObjects(); false for a stale handle. O(1).
+    bool isVisible(ObjectHandle object) const;
     /// Relinks moved objects now (renderFrame does it too; calling twice costs nothing).
     LooseBspFrameStats updateSceneTree();
     /// See EngineOptions::finishEachFrame.
@@ -133,7 +146,12 @@ private:
     std::vector<glm::vec3> colour_;  // per object slot
     std::vector<std::uint8_t> hasColour_;
     DrawPartCallback callback_;
-    PartObserver observer_;
+    std::vector<VisiblePart> visibleParts_;
+    std::vector<ObjectHandle> visibleObjects_;
+    std::vector<std::uint32_t> visibleFrame_;  // per object slot: frameSerial_ of the last frame that drew it
+    std::uint32_t frameSerial_ = 0;            // frames rendered so far (renderFrame and renderParts)
+    /// Starts a frame's visible lists.
+    void beginVisibleLists();
     bool finishEachFrame_ = false;
     std::uint64_t callerGlErrors_ = 0;
 };

@@ -8,10 +8,12 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "dyncull/bsp/scene_objects.hpp"
 #include "dyncull/bsp/traversal.hpp"
+#include "dyncull/engine/engine.hpp"
 #include "dyncull/objects/camera.hpp"
 #include "dyncull/objects/error.hpp"
 
@@ -20,19 +22,9 @@ namespace dyncull {
 class Engine;
 class GlContext;
 
-/// A drawable part: object slot of SceneObjects and a local-BSP node of its model.
-struct PartKey {
-    std::uint32_t object = 0;
-    std::uint32_t node = 0;
-    friend bool operator==(const PartKey&, const PartKey&) = default;
-    friend bool operator<(const PartKey& a, const PartKey& b) {
-        return a.object != b.object ? a.object < b.object : a.node < b.node;
-    }
-};
-
 /// The parts visible in one frame, sorted by key, with the pixels each covers.
 struct VisibleSet {
-    std::vector<PartKey> parts;          ///< sorted ascending, unique
+    std::vector<NodeRef> parts;          ///< sorted ascending, unique
     std::vector<std::uint32_t> pixels;   ///< pixels[i]: pixels part i owns (> 0)
     std::uint64_t coveredPixels = 0;     ///< sum of pixels (pixels showing any part)
     std::uint32_t candidates = 0;        ///< parts drawn by the ID pass (not outside the frustum)
@@ -42,8 +34,8 @@ struct VisibleSet {
     std::uint32_t artefactPixels = 0;
 
     /// Pixels of `key`, 0 if not visible. O(log n).
-    std::uint32_t pixelsOf(PartKey key) const;
-    bool contains(PartKey key) const { return pixelsOf(key) > 0; }
+    std::uint32_t pixelsOf(NodeRef key) const;
+    bool contains(NodeRef key) const { return pixelsOf(key) > 0; }
 };
 
 /// Owns an FBO (R32UI ids + DEPTH32F) the size of the context and its own copy of every
@@ -96,28 +88,10 @@ private:
     double lastMs_ = 0.0;
 };
 
-/// Turns the index ranges a mode drew (PartSink / Engine::setPartObserver calls) into the
-/// non-empty leaves they cover. Keeps a per-model index of leaves by first index.
-class DrawnPartRecorder {
-public:
-    /// Starts a new frame's record.
-    void clear() {
-        drawn_.clear();
-        sorted_ = true;
-    }
-    /// Records the range [firstIndex, firstIndex + indexCount) of object slot `object`.
-    void record(const SceneObjects& objects, std::uint32_t object, std::uint32_t firstIndex, std::uint32_t indexCount);
-    /// The leaves drawn this frame, sorted and unique (sorts on call).
-    const std::vector<PartKey>& drawn();
-
-private:
-    struct LeafStart {
-        std::uint32_t firstIndex, node;
-    };
-    std::vector<std::vector<LeafStart>> leaves_;  // per model, ascending firstIndex
-    std::vector<PartKey> drawn_;
-    bool sorted_ = true;
-};
+/// The non-empty leaves covered by the parts a frame drew (Engine::visibleParts), sorted
+/// and unique: a drawn part is a leaf, or an inner node whose whole subtree was drawn in one
+/// call (a single-node model's root counts even when empty).
+std::vector<NodeRef> drawnLeaves(const SceneObjects& objects, std::span<const VisiblePart> parts);
 
 /// How a drawn set differs from the visible set.
 struct PartErrors {
@@ -126,7 +100,7 @@ struct PartErrors {
     std::uint32_t falsePositives = 0;        ///< drawn parts with no visible pixel
     std::uint32_t drawn = 0;
 };
-/// `drawn` sorted and unique (DrawnPartRecorder::drawn).
-PartErrors compareParts(const VisibleSet& truth, const std::vector<PartKey>& drawn);
+/// `drawn` sorted and unique (drawnLeaves).
+PartErrors compareParts(const VisibleSet& truth, const std::vector<NodeRef>& drawn);
 
 }  // namespace dyncull

@@ -10,6 +10,7 @@
 
 #include <glm/glm.hpp>
 
+#include "dyncull/bsp/traversal.hpp"
 #include "dyncull/bsp/node_volumes.hpp"
 #include "dyncull/objects/aabb.hpp"
 #include "dyncull/objects/camera.hpp"
@@ -130,12 +131,14 @@ public:
     }
 };
 
-/// What the scheduler calls to draw an object part: slot `object` of SceneObjects, the
-/// index range [firstIndex, firstIndex + indexCount) of its model's split mesh.
+/// What the scheduler calls to draw an object part: `part` names the object slot of
+/// SceneObjects and the local-BSP node (a leaf, or an inner node whose whole subtree is
+/// drawn at once), and [firstIndex, firstIndex + indexCount) is that node's range of its
+/// model's split mesh.
 class PartSink {
 public:
     virtual ~PartSink() = default;
-    virtual void drawPart(std::uint32_t object, std::uint32_t firstIndex, std::uint32_t indexCount) = 0;
+    virtual void drawPart(NodeRef part, std::uint32_t firstIndex, std::uint32_t indexCount) = 0;
 };
 
 }  // namespace dyncull
