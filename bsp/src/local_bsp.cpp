@@ -30,7 +30,7 @@ using detail::Triangle;
 class Builder {
 public:
     Builder(const LocalBspParams& params, LocalBsp& out)
-        : params_(params), out_(out), splitter_(out.mesh.positions, out.mesh.normals) {}
+        : params_(params), out_(out), splitter_(out.mesh.positions, out.mesh.normals, out.splitVertices) {}
 
     void run(const std::vector<std::uint32_t>& indices) {
         const std::size_t n = indices.size() / 3;
@@ -176,6 +176,7 @@ Expected<LocalBsp> buildLocalBsp(const Mesh& mesh, const LocalBspParams& params)
     bsp.mesh.positions = mesh.positions;
     bsp.mesh.normals = mesh.normals;
     bsp.mesh.indices = mesh.indices;
+    bsp.sourceVertexCount = static_cast<std::uint32_t>(mesh.positions.size());
     // Orientation is decided on the whole input surface: the split mesh has T-junctions
     // where a plane cut one triangle but not its neighbour, which would read as holes.
     if (params.faces != FacePolicy::TwoSided) {

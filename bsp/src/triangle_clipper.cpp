@@ -36,6 +36,7 @@ std::uint32_t EdgeSplitter::split(std::uint32_t a, std::uint32_t b) {
     n = (len > 0.0f && std::isfinite(len)) ? n / len : na;  // opposite normals: keep one
     positions_.push_back(p);
     normals_.push_back(n);
+    splits_.push_back({a, b, float(t)});
     return it->second;
 }
 

@@ -12,6 +12,8 @@
 
 #include <glm/glm.hpp>
 
+#include "dyncull/bsp/local_bsp.hpp"
+
 namespace dyncull::detail {
 
 using Triangle = std::array<std::uint32_t, 3>;  ///< vertex indices, counter-clockwise
@@ -27,8 +29,8 @@ inline int planeSide(float coord, float plane, float eps) {
 /// the two triangles sharing an edge get the same new vertex, so the mesh stays indexed.
 class EdgeSplitter {
 public:
-    EdgeSplitter(std::vector<glm::vec3>& positions, std::vector<glm::vec3>& normals)
-        : positions_(positions), normals_(normals) {}
+    EdgeSplitter(std::vector<glm::vec3>& positions, std::vector<glm::vec3>& normals, std::vector<SplitVertex>& splits)
+        : positions_(positions), normals_(normals), splits_(splits) {}
 
     /// Starts a new plane (axis 0..2, position in object space); forgets shared vertices.
     void reset(int axis, float plane);
@@ -38,6 +40,7 @@ public:
 private:
     std::vector<glm::vec3>& positions_;
     std::vector<glm::vec3>& normals_;
+    std::vector<SplitVertex>& splits_;  // one per vertex appended: where on which edge
     std::unordered_map<std::uint64_t, std::uint32_t> cache_;  // reused: clear() keeps buckets
     int axis_ = 0;
     float plane_ = 0.0f;

@@ -44,6 +44,11 @@ Status Engine::enterGl(const char* what) {
     return {};
 }
 
+Status Engine::checkDrawer(const char* what) const {
+    if (renderer_ || callback_) return {};
+    return Error{std::string(what) + ": no draw callback, and the part renderer is off (EngineOptions::partRenderer)"};
+}
+
 Status Engine::leaveGl(const char* what) {
     if (Status s = context_.checkReset(); !s) return s;
     return context_.checkErrorsDuring(what);
@@ -53,9 +58,11 @@ Expected<std::unique_ptr<Engine>> Engine::create(GlContext& context, const Engin
     if (Status s = validateSchedulerParams(options.scheduler); !s) return s.error();
     std::unique_ptr<Engine> e(new Engine(context, options));
     if (Status s = e->enterGl("creating the engine"); !s) return s.error();
-    auto renderer = Renderer::create(context);
-    if (!renderer) return renderer.error();
-    e->renderer_ = renderer.take();
+    if (options.partRenderer) {
+        auto renderer = Renderer::create(context);
+        if (!renderer) return renderer.error();
+        e->renderer_ = renderer.take();
+    }
     auto backend = GlQueryBackend::create(context, options.queries);
     if (!backend) return backend.error();
     e->backend_ = backend.take();
@@ -74,12 +81,16 @@ Expected<ModelId> Engine::addModel(const Mesh& mesh, const LocalBspParams& param
 Expected<ModelId> Engine::addModel(LocalBsp bsp) {
     if (Status s = enterGl("adding a model"); !s) return s.error();
     // Upload first: if the GPU refuses, nothing has been registered yet.
-    auto mesh = renderer_->upload(bsp.mesh, bsp.faces);
-    if (!mesh) return mesh.error();
+    MeshId mesh = 0;
+    if (renderer_) {
+        auto uploaded = renderer_->upload(bsp.mesh, bsp.faces);
+        if (!uploaded) return uploaded.error();
+        mesh = *uploaded;
+    }
     if (Status s = leaveGl("adding a model"); !s) return s.error();
     const ModelId id = objects_.addModel(std::move(bsp));
     if (meshOfModel_.size() <= id) meshOfModel_.resize(id + 1);
-    meshOfModel_[id] = *mesh;
+    meshOfModel_[id] = mesh;
     return id;
 }
 
@@ -144,6 +155,7 @@ LooseBspFrameStats Engine::updateSceneTree() {
 
 Expected<FrameStats> Engine::renderFrame(QueryScheduler& scheduler) {
     beginVisibleLists();  // a refused frame draws nothing
+    if (Status s = checkDrawer("renderFrame"); !s) return s.error();
     if (Status s = enterGl("renderFrame"); !s) return s.error();
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();
@@ -152,11 +164,11 @@ Expected<FrameStats> Engine::renderFrame(QueryScheduler& scheduler) {
     detail::GlStateScope scope;
     const FrameTarget& target = scope.target();
     backend_->setTarget(target);
-    renderer_->beginFrame(camera_);
+    if (renderer_) renderer_->beginFrame(camera_);
     Sink sink(*this);
     TwoLevelTree tree(tree_, objects_);
     FrameStats st = scheduler.cullFrame(tree, camera_, target.width(), target.height(), *backend_, sink);
-    renderer_->endFrame();
+    if (renderer_) renderer_->endFrame();
     if (finishEachFrame_) glFinish();
     scope.restore();
     // A reset during the frame: its image and query results are undefined, so report it.
@@ -169,12 +181,13 @@ Expected<FrameStats> Engine::renderFrame(QueryScheduler& scheduler) {
 
 Expected<FrameStats> Engine::renderParts(const std::vector<NodeRef>& parts) {
     beginVisibleLists();
+    if (Status s = checkDrawer("renderParts"); !s) return s.error();
     if (Status s = enterGl("renderParts"); !s) return s.error();
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();
     const double updateMs = updateSceneTree().updateMs;
     detail::GlStateScope scope;
-    renderer_->beginFrame(camera_);
+    if (renderer_) renderer_->beginFrame(camera_);
     Sink sink(*this);
     FrameStats st;
     const auto tDraw = Clock::now();
@@ -189,7 +202,7 @@ Expected<FrameStats> Engine::renderParts(const std::vector<NodeRef>& parts) {
     }
     st.drawMs = std::chrono::duration<double, std::milli>(Clock::now() - tDraw).count();
     st.nodesVisited = st.partsDrawn;
-    renderer_->endFrame();
+    if (renderer_) renderer_->endFrame();
     if (finishEachFrame_) glFinish();
     scope.restore();
     if (Status s = leaveGl("renderParts"); !s) return s.error();

@@ -155,6 +155,34 @@ TEST_P(BothMethods, OriginalVerticesKeptAndSplitVerticesShared) {
     for (const glm::vec3& n : bsp.mesh.normals) EXPECT_NEAR(glm::length(n), 1.0f, 1e-4f);
 }
 
+// A game's own attributes follow the split: carrying the input positions themselves as
+// the attribute must give the split mesh's positions (the planes cut edges in double
+// precision and clamp, so equal to float rounding), and a constant stays constant.
+TEST_P(BothMethods, AttributesCarriedThroughTheSplitMatchTheSplitPositions) {
+    const Mesh mesh = sphereMesh(32, 16);
+    const LocalBsp bsp = buildOk(mesh, params(60));
+    ASSERT_EQ(bsp.sourceVertexCount, mesh.positions.size());
+    ASSERT_EQ(bsp.sourceVertexCount + bsp.splitVertices.size(), bsp.mesh.positions.size());
+    ASSERT_GT(bsp.splitVertices.size(), 0u);
+    std::vector<float> xyzw;  // position and a constant fourth component
+    for (const glm::vec3& p : mesh.positions) xyzw.insert(xyzw.end(), {p.x, p.y, p.z, 0.25f});
+    auto carried = carryAttributes(bsp, xyzw, 4);
+    ASSERT_TRUE(carried.ok()) << carried.error().message;
+    ASSERT_EQ(carried->size(), 4 * bsp.mesh.positions.size());
+    for (std::size_t v = 0; v < bsp.mesh.positions.size(); ++v) {
+        for (int k = 0; k < 3; ++k) EXPECT_NEAR((*carried)[4 * v + k], bsp.mesh.positions[v][k], 1e-5f) << v;
+        EXPECT_FLOAT_EQ((*carried)[4 * v + 3], 0.25f);
+    }
+    // Bad sizes and missing provenance are errors, not crashes.
+    EXPECT_FALSE(carryAttributes(bsp, xyzw, 0).ok());
+    EXPECT_FALSE(carryAttributes(bsp, std::span<const float>(xyzw).first(xyzw.size() - 1), 4).ok());
+    LocalBsp handMade = bsp;
+    handMade.splitVertices.clear();
+    auto none = carryAttributes(handMade, xyzw, 4);
+    ASSERT_FALSE(none.ok());
+    EXPECT_NE(none.error().message.find("provenance"), std::string::npos) << none.error().message;
+}
+
 TEST_P(BothMethods, FlatGridTerminates) {
     const Mesh mesh = gridMesh(60);
     const LocalBspParams p = params(300);

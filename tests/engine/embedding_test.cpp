@@ -337,6 +337,41 @@ TEST(Embedding, GlErrorsRaisedInsideAFrameComeBackAsErrors) {
     (void)ctx->checkErrors();  // the deliberate errors were counted
 }
 
+// Without the part renderer nothing is uploaded, a frame without a draw callback is
+// refused, and with one the game draws exactly the parts dyncull reports visible.
+TEST(Embedding, WithoutThePartRendererTheGameDrawsThePartsItIsTold) {
+    auto ctx = test::headless();
+    ASSERT_TRUE(ctx);
+    EngineOptions eo;
+    eo.partRenderer = false;
+    auto made = Engine::create(*ctx, eo);
+    ASSERT_TRUE(made.ok()) << made.error().message;
+    Engine& engine = **made;
+    EXPECT_FALSE(engine.hasRenderer());
+    const ModelId ball = *engine.addModel(test::sphereMesh(0.3f));
+    const ObjectHandle a = *engine.addObject(ball, at({-0.5f, 0, 0}));
+    const ObjectHandle b = *engine.addObject(ball, at({0.5f, 0, 0}));
+    const ObjectHandle gone = *engine.addObject(ball, at({50, 0, 0}));  // outside the frustum
+    ASSERT_TRUE(engine.setCamera(test::cameraOnZ(3.0f)).ok());
+
+    auto refused = engine.renderFrame();
+    ASSERT_FALSE(refused.ok());
+    EXPECT_EQ(refused.error().code, ErrorCode::BadArgument);
+    EXPECT_TRUE(engine.visibleParts().empty());
+
+    std::vector<ObjectHandle> drawn;
+    engine.setDrawCallback([&](ObjectHandle o, ModelId, std::uint32_t, std::uint32_t, const glm::mat4&) { drawn.push_back(o); });
+    ctx->clearFramebuffer(Renderer::kClearColour);
+    auto st = engine.renderFrame();
+    ASSERT_TRUE(st.ok()) << st.error().message;
+    EXPECT_EQ(drawn.size(), engine.visibleParts().size());
+    EXPECT_TRUE(engine.isVisible(a));
+    EXPECT_TRUE(engine.isVisible(b));
+    EXPECT_FALSE(engine.isVisible(gone));
+    EXPECT_EQ(engine.visibleObjects().size(), 2u);
+    EXPECT_EQ(ctx->checkErrors(), 0u);
+}
+
 // A game's own context, wrapped: two engines (split screen) draw into its framebuffer side
 // by side, and dropping the wrapper leaves the game's context working.
 TEST(Embedding, TwoEnginesOnABorrowedContextDrawSideBySide) {

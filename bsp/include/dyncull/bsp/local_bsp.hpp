@@ -4,6 +4,8 @@
 // split cost option from Scene subdivision for occlusion culling, section 3.2 (p-HBVO SAH).
 #pragma once
 
+#include <span>
+
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -85,10 +87,23 @@ struct LocalBspStats {
     double buildMs = 0.0;  ///< including the node volumes
 };
 
+/// A vertex the splitting added where an edge crossed a plane: (1 - t) * vertex a + t * vertex b
+/// (indices of earlier vertices of the split mesh, a < b, t in [0, 1]).
+struct SplitVertex {
+    std::uint32_t a = 0, b = 0;
+    float t = 0.0f;
+};
+
 /// The split mesh and its tree. Owns both. A mesh at or below maxLeafTriangles gets a
 /// single leaf root (no tree), so traversal code never special-cases it.
 struct LocalBsp {
     Mesh mesh;  ///< the input re-triangulated along split planes, indices ordered by leaf
+    /// Provenance of mesh's vertices, so a game can carry its own vertex attributes through
+    /// the split (carryAttributes): the first sourceVertexCount vertices are the input's, at
+    /// their indices; vertex sourceVertexCount + i is splitVertices[i]. Both are empty/0 for a
+    /// BSP made without them (by hand, or read from a file that does not store them).
+    std::uint32_t sourceVertexCount = 0;
+    std::vector<SplitVertex> splitVertices;
     std::vector<LocalBspNode> nodes;  ///< nodes[0] is the root
     /// Each node's query volumes (object space), indexed like `nodes`. Filled by
     /// buildLocalBsp; a hand-made or cache-loaded LocalBsp gets them in SceneObjects::addModel.
@@ -112,6 +127,15 @@ struct LocalBsp {
 /// maxLeafTriangles == 0, maxDepth > kLocalBspMaxDepth, nudgeFraction not in [0, 0.5].
 /// An empty mesh gives a single empty leaf.
 Expected<LocalBsp> buildLocalBsp(const Mesh& mesh, const LocalBspParams& params = {});
+
+/// A game's per-vertex data for the input mesh (`components` floats per vertex, in vertex
+/// order: texture coordinates, tangents, colours, skinning weights...) extended to every
+/// vertex of the split mesh, the added ones interpolated along their edges exactly as their
+/// positions were, so the index ranges of the BSP's parts can be drawn from the game's own
+/// vertex buffer. Errors: components 0, a size that is not sourceVertexCount x components,
+/// or a BSP without provenance (see LocalBsp::sourceVertexCount).
+Expected<std::vector<float>> carryAttributes(const LocalBsp& bsp, std::span<const float> attributes,
+                                             std::uint32_t components);
 
 /// Reorders the triangles inside each leaf of `bsp` for the post-transform vertex cache and
 /// then for overdraw (meshoptimizer); every node keeps its index range and triangle set.

@@ -4,6 +4,7 @@
 //   query backend -> draw (dyncull's renderer, or the game's callback).
 #pragma once
 
+#include <cassert>
 #include <functional>
 #include <memory>
 #include <span>
@@ -28,12 +29,21 @@ struct EngineOptions {
     /// glFinish at the end of every frame, so FrameStats::frameMs bounds the GPU work too
     /// (measurement); off, a frame only submits its work, as a game wants.
     bool finishEachFrame = false;
+    /// dyncull's own part renderer: addModel uploads each model's split mesh (positions and
+    /// normals) to the GPU, and parts are drawn with it unless a draw callback is set. Off,
+    /// nothing is uploaded (a game drawing its own buffers keeps one copy) and every frame
+    /// needs a draw callback.
+    bool partRenderer = true;
 };
 
 /// Draws one object part with the game's own renderer: `object` is the handle given by
-/// addObject, the range indexes the model's split mesh (Engine::model(id).mesh), and
-/// `objectToWorld` is the object's current matrix. Called between beginFrame/endFrame
-/// with dyncull's GL state otherwise untouched.
+/// addObject, the range indexes the model's split mesh (Engine::model(id).mesh.indices),
+/// and `objectToWorld` is the object's current matrix. A game draws it from its own vertex
+/// buffer holding its attributes carried through the split (carryAttributes, local_bsp.hpp)
+/// and the split mesh's indices. Called inside renderFrame, into the caller's framebuffer
+/// and viewport, with the frame contract's state (frame_contract.hpp): the callback may
+/// bind its own program, vertex array, buffers and textures (restored after the frame) and
+/// must keep the depth test and reversed-Z convention.
 using DrawPartCallback =
     std::function<void(ObjectHandle object, ModelId model, std::uint32_t firstIndex, std::uint32_t indexCount,
                        const glm::mat4& objectToWorld)>;
@@ -120,7 +130,12 @@ public:
     const LooseBsp& sceneTree() const { return tree_; }
     const LocalBsp& model(ModelId id) const { return objects_.model(id); }
     const Camera& camera() const { return camera_; }
-    Renderer& renderer() { return *renderer_; }
+    /// dyncull's part renderer; only with EngineOptions::partRenderer.
+    Renderer& renderer() {
+        assert(renderer_ && "EngineOptions::partRenderer is off");
+        return *renderer_;
+    }
+    bool hasRenderer() const { return renderer_ != nullptr; }
     GlContext& context() { return context_; }
     QueryScheduler& scheduler() { return scheduler_; }
     GlQueryBackend& queryBackend() { return *backend_; }
@@ -131,6 +146,8 @@ private:
     /// Before a call's GL work: the context is current and not lost; the caller's pending
     /// GL errors are set aside (callerGlErrors_).
     Status enterGl(const char* what);
+    /// Something draws the parts: the part renderer or a draw callback (BadArgument otherwise).
+    Status checkDrawer(const char* what) const;
     /// After it: not lost, and no GL error raised during the call.
     Status leaveGl(const char* what);
 
