@@ -26,11 +26,12 @@
 #include <epoxy/gl.h>
 #include <glm/gtc/type_ptr.hpp>
 
+#include "dyncull/measure/png_writer.hpp"
 #include "dyncull/demos/demo_scene.hpp"
 #include "dyncull/engine/engine.hpp"
 #include "dyncull/engine/gl_context.hpp"
 #include "dyncull/engine/image.hpp"
-#include "dyncull/engine/image_compare.hpp"
+#include "dyncull/measure/image_compare.hpp"
 #include "dyncull/objects/checked_write.hpp"
 #include "shader_program.hpp"  // engine-internal: the engine's own compile-and-link
 

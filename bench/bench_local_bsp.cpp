@@ -8,7 +8,7 @@
 #include <string>
 
 #include "dyncull/bsp/local_bsp.hpp"
-#include "dyncull/objects/loaders.hpp"
+#include "dyncull/loaders/loaders.hpp"
 
 namespace {
 

@@ -1,4 +1,4 @@
-// What every loader must guarantee for any input (objects/include/dyncull/objects/loaders.hpp):
+// What every loader must guarantee for any input (objects/include/dyncull/loaders/loaders.hpp):
 // either an Error with a one-line message naming the file, or a complete Scene whose meshes
 // all pass validateMesh() and whose instances name existing meshes with finite matrices.
 // A violation aborts, which libFuzzer reports as a crash with the input saved.
@@ -11,7 +11,7 @@
 #include <string>
 
 #include "dyncull/bsp/local_bsp.hpp"
-#include "dyncull/objects/loaders.hpp"
+#include "dyncull/loaders/loaders.hpp"
 
 namespace dyncull::fuzz {
 

@@ -12,7 +12,7 @@
 #include <fstream>
 #include <string>
 
-#include "dyncull/objects/loaders.hpp"
+#include "dyncull/loaders/loaders.hpp"
 
 namespace {
 

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "dyncull/measure/png_writer.hpp"
 #include "dyncull/bsp/traversal.hpp"
 #include "dyncull/engine/gl_context.hpp"
 #include "report_writer.hpp"

@@ -13,9 +13,9 @@
 #include "dyncull/bsp/volume_totals.hpp"
 #include "dyncull/demos/demo_scene.hpp"
 #include "dyncull/engine/engine.hpp"
-#include "dyncull/engine/ground_truth.hpp"
+#include "dyncull/measure/ground_truth.hpp"
 #include "dyncull/engine/image.hpp"
-#include "dyncull/engine/image_compare.hpp"
+#include "dyncull/measure/image_compare.hpp"
 #include "dyncull/objects/error.hpp"
 #include "dyncull/scheduler/query_scheduler.hpp"
 

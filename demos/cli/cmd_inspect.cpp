@@ -9,7 +9,7 @@
 #include "commands.hpp"
 #include "scene_options.hpp"
 #include "dyncull/bsp/local_bsp.hpp"
-#include "dyncull/objects/loaders.hpp"
+#include "dyncull/loaders/loaders.hpp"
 #include "dyncull/objects/surface_orientation.hpp"
 
 namespace dyncull::cli {

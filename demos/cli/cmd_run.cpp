@@ -13,6 +13,8 @@
 #include "cli_util.hpp"
 #include "commands.hpp"
 #include "crash_report.hpp"
+#include "dyncull/viewer/window_context.hpp"
+#include "dyncull/measure/png_writer.hpp"
 #include "dyncull/demos/progress_bar.hpp"
 #include "dyncull/objects/checked_write.hpp"
 #include "dyncull/demos/demo_scene.hpp"
@@ -83,9 +85,10 @@ void runRun(RunOptions o) {
     co.width = size->x;
     co.height = size->y;
     co.title = "dyncull run " + o.scene;
-    auto context = GlContext::create(co);
+    auto context = createContext(co);
     if (!context) fail(context.error().message);
     GlContext& ctx = **context;
+    auto* window = dynamic_cast<WindowContext*>(&ctx);  // null when headless
 
     EngineOptions eo;
     eo.finishEachFrame = true;  // frame times include the GPU's work
@@ -104,7 +107,7 @@ void runRun(RunOptions o) {
         io.params = eo.scheduler;
         io.maxFrames = o.frames;
         io.boxes = o.boxes;
-        ContextInput input(ctx);
+        ContextInput input(*window);
         InteractiveState last;
         auto n = runInteractive(ctx, engine, scene, input, io, &last);
         if (!n) fail(n.error().message);
@@ -137,7 +140,7 @@ void runRun(RunOptions o) {
     if (!o.window) progress.emplace("run " + scene.name() + " " + o.mode, static_cast<double>(frames));
     setInterruptPolled(true);
     std::uint64_t frame = 0;
-    for (; frame < frames && !ctx.shouldClose() && !interruptRequested(); ++frame) {
+    for (; frame < frames && !(window && window->shouldClose()) && !interruptRequested(); ++frame) {
         setCrashFrame(frame, o.mode.c_str());
         if (Status s = scene.update(engine, frame); !s) fail(s.message());
         if (Status s = engine.setCamera(scene.camera(frame, aspect)); !s)

@@ -8,11 +8,13 @@
 #include "cli_util.hpp"
 #include "commands.hpp"
 #include "scene_options.hpp"
+#include "dyncull/viewer/window_context.hpp"
+#include "dyncull/measure/png_writer.hpp"
 #include "dyncull/engine/gl_context.hpp"
 #include "dyncull/engine/image.hpp"
 #include "dyncull/engine/renderer.hpp"
 #include "dyncull/objects/camera.hpp"
-#include "dyncull/objects/loaders.hpp"
+#include "dyncull/loaders/loaders.hpp"
 
 namespace dyncull::cli {
 
@@ -70,9 +72,10 @@ void runView(const ViewOptions& o) {
     co.height = size->y;
     co.debug = o.debug;
     co.title = "dyncull view " + o.file;
-    auto context = GlContext::create(co);
+    auto context = createContext(co);
     if (!context) fail(context.error().message);
     GlContext& ctx = **context;
+    auto* window = dynamic_cast<WindowContext*>(&ctx);  // null when headless
     auto made = Renderer::create(ctx);
     if (!made) fail(made.error().message);
     Renderer& renderer = **made;
@@ -119,7 +122,7 @@ void runView(const ViewOptions& o) {
 
     if (o.window) {
         // Keep showing the framed scene until the window is closed (or --frames is reached).
-        for (int frame = 0; !ctx.shouldClose() && (o.frames <= 0 || frame < o.frames); ++frame) {
+        for (int frame = 0; !window->shouldClose() && (o.frames <= 0 || frame < o.frames); ++frame) {
             ctx.present();
             camera.aspect = static_cast<float>(ctx.size().x) / static_cast<float>(ctx.size().y);
             drawScene(renderer, scene, ids, camera);

@@ -58,8 +58,7 @@ void InteractiveViewer::applyKeys(const InputFrame& in) {
     if (in.wasPressed(Key::O)) state_.useOccupancy = !state_.useOccupancy;
     if (in.wasPressed(Key::T)) state_.useTight = !state_.useTight;
     if (in.wasPressed(Key::M)) {
-        state_.mouseLook = !state_.mouseLook;
-        engine_.context().setCursorCaptured(state_.mouseLook);
+        state_.mouseLook = !state_.mouseLook;  // runInteractive tells the input source
     }
     if (in.wasPressed(Key::Equal) || in.wasPressed(Key::KeypadAdd)) state_.speedScale *= 1.5f;
     if (in.wasPressed(Key::Minus) || in.wasPressed(Key::KeypadSubtract)) state_.speedScale /= 1.5f;
@@ -166,14 +165,16 @@ Expected<std::uint64_t> runInteractive(GlContext& context, Engine& engine, DemoS
     double dt = 0.0;
     while (options.maxFrames == 0 || viewer.state().framesRendered < options.maxFrames) {
         const InputFrame in = input.poll();
+        const bool mouseLook = viewer.state().mouseLook;
         if (Status s = viewer.step(in, dt); !s) return s.error();
+        if (viewer.state().mouseLook != mouseLook) input.setCursorCaptured(viewer.state().mouseLook);
         if (viewer.state().quit) break;
         context.present();
         const auto now = Clock::now();
         dt = std::chrono::duration<double>(now - last).count();
         last = now;
     }
-    context.setCursorCaptured(false);
+    input.setCursorCaptured(false);
     if (finalState) *finalState = viewer.state();
     return viewer.state().framesRendered;
 }

@@ -17,9 +17,10 @@
 #include <string>
 #include <vector>
 
+#include "dyncull/viewer/window_context.hpp"
 #include "dyncull/demos/demo_scene.hpp"
 #include "dyncull/engine/engine.hpp"
-#include "dyncull/engine/input.hpp"
+#include "dyncull/viewer/input.hpp"
 #include "node_box_view.hpp"
 
 namespace dyncull::cli {
@@ -29,16 +30,19 @@ class InputSource {
 public:
     virtual ~InputSource() = default;
     virtual InputFrame poll() = 0;
+    /// Mouse look: hide and lock the cursor (false releases it). Only windows have one.
+    virtual void setCursorCaptured(bool /*captured*/) {}
 };
 
-/// Input of a window (GlContext::takeInput); empty frames for a headless context.
+/// Input of a window (WindowContext::takeInput).
 class ContextInput final : public InputSource {
 public:
-    explicit ContextInput(GlContext& context) : context_(context) {}
-    InputFrame poll() override { return context_.takeInput(); }
+    explicit ContextInput(WindowContext& window) : window_(window) {}
+    InputFrame poll() override { return window_.takeInput(); }
+    void setCursorCaptured(bool captured) override { window_.setCursorCaptured(captured); }
 
 private:
-    GlContext& context_;
+    WindowContext& window_;
 };
 
 /// A fixed script: the key presses of each frame (frame 0 = the first poll) and keys held

@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
-#include "dyncull/engine/debug_draw.hpp"
+#include "dyncull/viewer/debug_draw.hpp"
 #include "dyncull/engine/engine.hpp"
-#include "dyncull/engine/text_overlay.hpp"
+#include "dyncull/viewer/text_overlay.hpp"
 #include "dyncull/scheduler/query_scheduler.hpp"
 
 namespace dyncull::cli {

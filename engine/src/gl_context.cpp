@@ -96,7 +96,9 @@ Expected<std::unique_ptr<GlContext>> GlContext::create(const ContextOptions& opt
     if (options.width < 1 || options.height < 1 || options.width > 16384 || options.height > 16384)
         return Error{"context: size " + std::to_string(options.width) + "x" + std::to_string(options.height) +
                      " out of range (1..16384)"};
-    if (options.kind == ContextKind::GlfwWindow) return createGlfwContext(options);
+    if (options.kind == ContextKind::GlfwWindow)
+        return Error{"context: windows are the demos' viewer (dyncull/viewer/window_context.hpp), not the runtime",
+                     ErrorCode::Unsupported};
     return createEglContext(options);
 }
 

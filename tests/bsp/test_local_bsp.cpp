@@ -11,7 +11,7 @@
 #include <string>
 
 #include "dyncull/bsp/local_bsp.hpp"
-#include "dyncull/objects/loaders.hpp"
+#include "dyncull/loaders/loaders.hpp"
 #include "objects/sphere_grid.hpp"
 
 namespace dyncull {

@@ -1,7 +1,7 @@
 // Wireframe boxes land on the projected box edges, in their colour, and nowhere inside.
 #include <gtest/gtest.h>
 
-#include "dyncull/engine/debug_draw.hpp"
+#include "dyncull/viewer/debug_draw.hpp"
 #include "gl_test_util.hpp"
 #include "procedural_meshes.hpp"
 

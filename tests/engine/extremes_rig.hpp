@@ -9,8 +9,8 @@
 #include <string>
 
 #include "dyncull/engine/engine.hpp"
-#include "dyncull/engine/ground_truth.hpp"
-#include "dyncull/engine/image_compare.hpp"
+#include "dyncull/measure/ground_truth.hpp"
+#include "dyncull/measure/image_compare.hpp"
 #include "engine/gl_test_util.hpp"
 
 namespace dyncull::test {

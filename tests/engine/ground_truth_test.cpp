@@ -6,7 +6,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "dyncull/engine/engine.hpp"
-#include "dyncull/engine/ground_truth.hpp"
+#include "dyncull/measure/ground_truth.hpp"
 #include "engine/gl_test_util.hpp"
 #include "engine/procedural_meshes.hpp"
 #include "objects/transform_at.hpp"

@@ -1,7 +1,7 @@
 // Exact image comparison: percentages and the largest 4-connected wrong region.
 #include <gtest/gtest.h>
 
-#include "dyncull/engine/image_compare.hpp"
+#include "dyncull/measure/image_compare.hpp"
 
 namespace dyncull {
 namespace {

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "dyncull/measure/png_writer.hpp"
 #include "dyncull/engine/image.hpp"
 
 namespace dyncull {

@@ -22,7 +22,7 @@
 #include "dyncull/demos/demo_scene.hpp"
 #include "dyncull/engine/engine.hpp"
 #include "dyncull/engine/gl_context.hpp"
-#include "dyncull/engine/ground_truth.hpp"
+#include "dyncull/measure/ground_truth.hpp"
 #include "engine/gl_test_util.hpp"
 
 namespace dyncull {

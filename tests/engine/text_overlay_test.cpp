@@ -1,7 +1,7 @@
 // Built-in bitmap font: table sanity, measuring, and the exact pixels a glyph lights.
 #include <gtest/gtest.h>
 
-#include "dyncull/engine/text_overlay.hpp"
+#include "dyncull/viewer/text_overlay.hpp"
 #include "gl_test_util.hpp"
 
 namespace dyncull {

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include "dyncull/viewer/window_context.hpp"
 #include "dyncull/engine/renderer.hpp"
 #include "gl_test_util.hpp"
 #include "procedural_meshes.hpp"
@@ -18,7 +19,7 @@ TEST(Window, RendersIntoAFloatDepthFramebufferAndPresents) {
     o.height = 48;
     o.visible = false;
     o.debug = true;
-    auto ctx = GlContext::create(o);
+    auto ctx = WindowContext::create(o);
     ASSERT_TRUE(ctx.ok()) << ctx.error().message;
     EXPECT_EQ((*ctx)->kind(), ContextKind::GlfwWindow);
     EXPECT_NE((*ctx)->framebuffer(), 0u);  // offscreen, float depth: reversed Z
@@ -51,7 +52,7 @@ TEST(Window, NoDisplayIsAnErrorNotACrash) {
     ContextOptions o;
     o.kind = ContextKind::GlfwWindow;
     o.width = o.height = 8;
-    auto ctx = GlContext::create(o);
+    auto ctx = WindowContext::create(o);
     if (saved) setenv("DISPLAY", keep.c_str(), 1); else unsetenv("DISPLAY");
     ASSERT_FALSE(ctx.ok());
     EXPECT_EQ(ctx.error().message.rfind("GLFW: ", 0), 0u) << ctx.error().message;

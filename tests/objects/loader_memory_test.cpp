@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "dyncull/objects/loaders.hpp"
+#include "dyncull/loaders/loaders.hpp"
 #include "objects/alloc_peak.hpp"
 #include "objects/test_files.hpp"
 

@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-#include "dyncull/objects/loaders.hpp"
+#include "dyncull/loaders/loaders.hpp"
 #include "objects/test_files.hpp"
 
 namespace dyncull {

@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "dyncull/objects/loaders.hpp"
+#include "dyncull/loaders/loaders.hpp"
 
 namespace dyncull {
 namespace {

@@ -11,7 +11,7 @@
 #include <filesystem>
 
 #include "dyncull/objects/hole_capping.hpp"
-#include "dyncull/objects/loaders.hpp"
+#include "dyncull/loaders/loaders.hpp"
 #include "dyncull/objects/surface_orientation.hpp"
 
 using namespace dyncull;

@@ -9,7 +9,7 @@
 
 #include "dyncull/demos/demo_scene.hpp"
 #include "dyncull/objects/hole_capping.hpp"
-#include "dyncull/objects/loaders.hpp"
+#include "dyncull/loaders/loaders.hpp"
 #include "dyncull/objects/loop_subdivision.hpp"
 #include "dyncull/objects/motion.hpp"
 

@@ -4,7 +4,7 @@
 #include <filesystem>
 
 #include "dyncull/demos/demo_scene.hpp"
-#include "dyncull/objects/loaders.hpp"
+#include "dyncull/loaders/loaders.hpp"
 #include "dyncull/objects/motion.hpp"
 #include "file_camera.hpp"
 

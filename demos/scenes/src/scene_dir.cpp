@@ -5,7 +5,7 @@
 #include <filesystem>
 
 #include "dyncull/demos/demo_scene.hpp"
-#include "dyncull/objects/loaders.hpp"
+#include "dyncull/loaders/loaders.hpp"
 #include "dyncull/objects/motion.hpp"
 #include "generators.hpp"
 

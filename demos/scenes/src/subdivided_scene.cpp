@@ -9,7 +9,7 @@
 #include <filesystem>
 
 #include "dyncull/demos/demo_scene.hpp"
-#include "dyncull/objects/loaders.hpp"
+#include "dyncull/loaders/loaders.hpp"
 #include "dyncull/objects/surface_orientation.hpp"
 #include "generators.hpp"
 

@@ -11,14 +11,13 @@
 
 #include <glm/glm.hpp>
 
-#include "dyncull/engine/input.hpp"
 #include "dyncull/objects/error.hpp"
 
 namespace dyncull {
 
 enum class ContextKind : std::uint8_t {
     HeadlessEgl,  ///< EGL without a surface (Mesa surfaceless / device platform), offscreen FBO
-    GlfwWindow,   ///< GLFW window on an X display (or Xvfb)
+    GlfwWindow,   ///< GLFW window on an X display (or Xvfb): the demos' viewer (dyncull/viewer/window_context.hpp)
     Borrowed,     ///< the caller's context, current when GlContext::borrowCurrent was called
 };
 
@@ -54,9 +53,10 @@ struct GlFaultInjection {
 /// current (one thread at a time, as GL itself requires).
 class GlContext {
 public:
-    /// Creates and makes current. Never throws or aborts: failures come back as an Error
-    /// naming every attempt, e.g. "EGL: surfaceless Mesa platform: eglInitialize failed
-    /// (EGL_NOT_INITIALIZED); device platform: no devices; ...".
+    /// Creates a headless EGL context and makes it current. Never throws or aborts: failures
+    /// come back as an Error naming every attempt, e.g. "EGL: surfaceless Mesa platform:
+    /// eglInitialize failed (EGL_NOT_INITIALIZED); device platform: no devices; ...".
+    /// Windows are not part of the runtime: kind GlfwWindow is refused (Unsupported).
     static Expected<std::unique_ptr<GlContext>> create(const ContextOptions& options);
     /// Wraps the context current on this thread, which the caller (a game) created and keeps
     /// owning: destroying the wrapper leaves the native context, its framebuffers and its GL
@@ -88,14 +88,6 @@ public:
     /// Windows: copy the FBO's colour to the window, swap buffers, poll events, and follow
     /// a resize (size() and the FBO change with the window). Headless: glFlush.
     virtual void present() = 0;
-    /// Windows: the user asked to close. Headless: always false.
-    virtual bool shouldClose() const { return false; }
-    /// Windows: keyboard/mouse input gathered by present() since the previous call (held
-    /// keys are current; presses and mouse motion accumulate). Headless: an empty frame.
-    virtual InputFrame takeInput() { return {}; }
-    /// Windows: hide and lock the cursor so mouse motion is unbounded (mouse look); false
-    /// releases it. Headless: no-op.
-    virtual void setCursorCaptured(bool /*captured*/) {}
 
     ContextKind kind() const { return kind_; }
     /// GL name of the framebuffer to render into (an FBO with float depth; both kinds).
@@ -140,7 +132,6 @@ public:
 
 protected:
     friend Expected<std::unique_ptr<GlContext>> createEglContext(const ContextOptions&);
-    friend Expected<std::unique_ptr<GlContext>> createGlfwContext(const ContextOptions&);
     explicit GlContext(ContextKind kind) : kind_(kind) {}
     /// Called by subclasses once current: queries strings, makes the fingerprint of
     /// isCurrent(), installs the debug callback (and, for dyncull's own contexts, sets the
@@ -165,8 +156,5 @@ protected:
 
 /// Headless EGL context with an RGBA8 + depth32F FBO of the requested size.
 Expected<std::unique_ptr<GlContext>> createEglContext(const ContextOptions& options);
-/// GLFW window context with an RGBA8 + depth32F FBO of the window's framebuffer size;
-/// fails cleanly when there is no display.
-Expected<std::unique_ptr<GlContext>> createGlfwContext(const ContextOptions& options);
 
 }  // namespace dyncull

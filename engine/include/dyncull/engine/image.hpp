@@ -1,13 +1,11 @@
-// CPU-side RGBA8 image (e.g. a read-back frame) and PNG output.
+// CPU-side RGBA8 image (e.g. a read-back frame).
 #pragma once
 
 #include <cstdint>
-#include <filesystem>
 #include <vector>
 
 #include <glm/glm.hpp>
 
-#include "dyncull/objects/error.hpp"
 
 namespace dyncull {
 
@@ -23,8 +21,5 @@ struct Image {
         return {rgba[i], rgba[i + 1], rgba[i + 2], rgba[i + 3]};
     }
 };
-
-/// Writes `image` as PNG. The parent directory must exist. Error names the path.
-Status writePng(const Image& image, const std::filesystem::path& path);
 
 }  // namespace dyncull

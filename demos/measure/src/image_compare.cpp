@@ -1,5 +1,5 @@
 // Exact image difference and its largest 4-connected wrong region (see image_compare.hpp).
-#include "dyncull/engine/image_compare.hpp"
+#include "dyncull/measure/image_compare.hpp"
 
 #include <algorithm>
 #include <string>

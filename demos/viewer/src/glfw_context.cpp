@@ -8,7 +8,7 @@
 #include <epoxy/gl.h>  // before GLFW so GLFW does not pull in the system GL header
 #include <GLFW/glfw3.h>
 
-#include "dyncull/engine/gl_context.hpp"
+#include "dyncull/viewer/window_context.hpp"
 #include "glfw_input.hpp"
 
 namespace dyncull {
@@ -30,9 +30,8 @@ int& liveWindows() {
     return n;
 }
 
-class GlfwContext final : public GlContext {
+class GlfwContext final : public WindowContext {
 public:
-    GlfwContext() : GlContext(ContextKind::GlfwWindow) {}
     ~GlfwContext() override {
         if (window_) {
             GLFWwindow* previous = glfwGetCurrentContext();
@@ -85,7 +84,9 @@ public:
 
 }  // namespace
 
-Expected<std::unique_ptr<GlContext>> createGlfwContext(const ContextOptions& o) {
+Expected<std::unique_ptr<WindowContext>> WindowContext::create(const ContextOptions& o) {
+    if (o.width < 1 || o.height < 1 || o.width > 16384 || o.height > 16384)
+        return Error{"window: size " + std::to_string(o.width) + "x" + std::to_string(o.height) + " out of range (1..16384)"};
     glfwSetErrorCallback(onGlfwError);
     lastGlfwError().clear();
     if (!glfwInit()) return Error{"GLFW: glfwInit failed: " + lastGlfwError(), ErrorCode::Unsupported};
@@ -123,7 +124,14 @@ Expected<std::unique_ptr<GlContext>> createGlfwContext(const ContextOptions& o) 
     ctx->initCommon(o.debug);
     if (std::string e = ctx->resizeFramebuffer(std::max(w, 1), std::max(h, 1)); !e.empty()) return Error{"GLFW: " + e};
     glBindFramebuffer(GL_FRAMEBUFFER, ctx->framebuffer_);
-    return std::unique_ptr<GlContext>(std::move(ctx));
+    return std::unique_ptr<WindowContext>(std::move(ctx));
+}
+
+Expected<std::unique_ptr<GlContext>> createContext(const ContextOptions& options) {
+    if (options.kind != ContextKind::GlfwWindow) return GlContext::create(options);
+    auto window = WindowContext::create(options);
+    if (!window) return window.error();
+    return std::unique_ptr<GlContext>(window.take());
 }
 
 }  // namespace dyncull

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "checked_math.hpp"
-#include "dyncull/objects/loaders.hpp"
+#include "dyncull/loaders/loaders.hpp"
 #include "loader_common.hpp"
 #include "polygon_triangulation.hpp"
 

@@ -1,6 +1,6 @@
 // Ground-truth visibility by an ID pass (see ground_truth.hpp), and the bookkeeping that
 // compares what a culling mode drew against it.
-#include "dyncull/engine/ground_truth.hpp"
+#include "dyncull/measure/ground_truth.hpp"
 
 #include <algorithm>
 #include <cassert>

@@ -16,7 +16,7 @@
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
-#include "dyncull/objects/loaders.hpp"
+#include "dyncull/loaders/loaders.hpp"
 #include "dyncull/objects/transform.hpp"
 #include "loader_common.hpp"
 

@@ -1,6 +1,6 @@
 // Built-in 5x7 bitmap font and its renderer: the glyph table becomes a 475x7 R8 texture,
 // and each character is one instanced quad whose fragments look their font pixel up.
-#include "dyncull/engine/text_overlay.hpp"
+#include "dyncull/viewer/text_overlay.hpp"
 
 #include <algorithm>
 #include <cstring>

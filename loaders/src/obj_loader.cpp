@@ -12,7 +12,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "dyncull/objects/loaders.hpp"
+#include "dyncull/loaders/loaders.hpp"
 #include "loader_common.hpp"
 #include "polygon_triangulation.hpp"
 

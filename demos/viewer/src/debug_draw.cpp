@@ -1,7 +1,7 @@
 // Wide coloured lines: a geometry shader clips each segment against the near plane and
 // expands it into a screen-aligned quad of the requested pixel width (core-profile GL
 // rejects glLineWidth > 1 in forward-compatible contexts).
-#include "dyncull/engine/debug_draw.hpp"
+#include "dyncull/viewer/debug_draw.hpp"
 
 #include <cstring>
 #include <string>

@@ -1,7 +1,7 @@
 // Internal: collects a GLFW window's keyboard/mouse events into dyncull::InputFrame.
 #pragma once
 
-#include "dyncull/engine/input.hpp"
+#include "dyncull/viewer/input.hpp"
 
 struct GLFWwindow;
 

@@ -17,7 +17,7 @@
 #include <memory>
 #include <string_view>
 
-#include "dyncull/engine/image.hpp"
+#include "dyncull/measure/png_writer.hpp"
 #include "dyncull/objects/checked_write.hpp"
 
 namespace dyncull {

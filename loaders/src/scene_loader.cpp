@@ -2,7 +2,7 @@
 #include <cctype>
 #include <string>
 
-#include "dyncull/objects/loaders.hpp"
+#include "dyncull/loaders/loaders.hpp"
 #include "loader_common.hpp"
 
 namespace dyncull {
