@@ -2,6 +2,7 @@
 
 #include <cassert>
 #include <chrono>
+#include <string>
 
 #include <epoxy/gl.h>
 
@@ -9,17 +10,20 @@
 
 namespace dyncull {
 
+// Records every part in the view's visible lists, then draws it (the game's callback or
+// the part renderer).
 struct Engine::Sink final : PartSink {
     Engine& e;
-    explicit Sink(Engine& engine) : e(engine) {}
+    VisibleLists& visible;
+    Sink(Engine& engine, VisibleLists& lists) : e(engine), visible(lists) {}
     void drawPart(NodeRef part, std::uint32_t firstIndex, std::uint32_t indexCount) override {
         const SceneObjects& objs = e.objects_;
         const std::uint32_t object = part.object;
         const ObjectHandle handle = objs.handle(object);
-        e.visibleParts_.push_back({handle, part, firstIndex, indexCount});
-        if (e.visibleFrame_[object] != e.frameSerial_) {
-            e.visibleFrame_[object] = e.frameSerial_;
-            e.visibleObjects_.push_back(handle);
+        visible.parts.push_back({handle, part, firstIndex, indexCount});
+        if (visible.stamp[object] != visible.serial) {
+            visible.stamp[object] = visible.serial;
+            visible.objects.push_back(handle);
         }
         const ModelId model = objs.modelOf(object);
         if (e.callback_) {
@@ -32,10 +36,75 @@ struct Engine::Sink final : PartSink {
 };
 
 Engine::Engine(GlContext& context, const EngineOptions& options)
-    : context_(context),
-      tree_(options.sceneTree),
-      scheduler_(options.scheduler),
-      finishEachFrame_(options.finishEachFrame) {}
+    : context_(context), tree_(options.sceneTree), finishEachFrame_(options.finishEachFrame) {
+    View& main = views_.emplace_back();
+    main.scheduler = std::make_unique<QueryScheduler>(options.scheduler);
+}
+
+void Engine::VisibleLists::begin(std::uint32_t slots) {
+    if (++serial == 0) {  // wrapped after 2^32 frames: no slot may look drawn this frame
+        std::fill(stamp.begin(), stamp.end(), 0u);
+        serial = 1;
+    }
+    stamp.resize(slots, 0);
+    parts.clear();
+    objects.clear();
+}
+
+Engine::View* Engine::findView(ViewId id) { return id < views_.size() && views_[id].live ? &views_[id] : nullptr; }
+const Engine::View* Engine::findView(ViewId id) const {
+    return id < views_.size() && views_[id].live ? &views_[id] : nullptr;
+}
+
+namespace {
+Error unknownView(const char* what, ViewId id) {
+    return Error{std::string(what) + ": unknown or removed view " + std::to_string(id)};
+}
+}  // namespace
+
+Expected<ViewId> Engine::addView(const Camera& camera, const SchedulerParams& params) {
+    if (Status s = validateCamera(camera); !s) return s.error();
+    if (Status s = validateSchedulerParams(params); !s) return s.error();
+    View& v = views_.emplace_back();
+    v.camera = camera;
+    v.scheduler = std::make_unique<QueryScheduler>(params);
+    return static_cast<ViewId>(views_.size() - 1);
+}
+
+Status Engine::removeView(ViewId id) {
+    if (id == kMainView) return Error{"removeView: the main view cannot be removed"};
+    View* v = findView(id);
+    if (!v) return unknownView("removeView", id);
+    *v = View{};
+    v->live = false;  // ids are never reused, so a stale id stays an error
+    return {};
+}
+
+std::span<const VisiblePart> Engine::visibleParts(ViewId view) const {
+    const View* v = findView(view);
+    return v ? std::span<const VisiblePart>(v->visible.parts) : std::span<const VisiblePart>();
+}
+
+std::span<const ObjectHandle> Engine::visibleObjects(ViewId view) const {
+    const View* v = findView(view);
+    return v ? std::span<const ObjectHandle>(v->visible.objects) : std::span<const ObjectHandle>();
+}
+
+bool Engine::isVisible(ObjectHandle object, ViewId view) const {
+    const View* v = findView(view);
+    return v && objects_.alive(object) && object.index < v->visible.stamp.size() &&
+           v->visible.stamp[object.index] == v->visible.serial;
+}
+
+const Camera& Engine::camera(ViewId view) const {
+    const View* v = findView(view);
+    return v ? v->camera : views_[kMainView].camera;
+}
+
+QueryScheduler& Engine::scheduler(ViewId view) {
+    View* v = findView(view);
+    return *(v ? v : &views_[kMainView])->scheduler;
+}
 
 Status Engine::enterGl(const char* what) {
     if (Status s = context_.checkCurrent(what); !s) return s;
@@ -68,7 +137,7 @@ Expected<std::unique_ptr<Engine>> Engine::create(GlContext& context, const Engin
     e->backend_ = backend.take();
     if (Status s = e->leaveGl("creating the engine"); !s) return s.error();
     const glm::ivec2 size = context.size();
-    e->camera_.aspect = static_cast<float>(size.x) / static_cast<float>(size.y);
+    e->views_[kMainView].camera.aspect = static_cast<float>(size.x) / static_cast<float>(size.y);
     return e;
 }
 
@@ -104,15 +173,19 @@ Status Engine::setTransform(ObjectHandle object, const Transform& transform) {
     return objects_.setTransform(object, transform);
 }
 
-Status Engine::setCamera(const Camera& camera) {
+Status Engine::setCamera(ViewId view, const Camera& camera) {
+    View* v = findView(view);
+    if (!v) return unknownView("setCamera", view);
     if (Status s = validateCamera(camera); !s) return s;
-    camera_ = camera;
+    v->camera = camera;
     return {};
 }
 
-Status Engine::setSchedulerParams(const SchedulerParams& params) {
+Status Engine::setSchedulerParams(ViewId view, const SchedulerParams& params) {
+    View* v = findView(view);
+    if (!v) return unknownView("setSchedulerParams", view);
     if (Status s = validateSchedulerParams(params); !s) return s;
-    scheduler_.setParams(params);
+    v->scheduler->setParams(params);
     return {};
 }
 
@@ -124,21 +197,6 @@ void Engine::setColour(ObjectHandle object, const glm::vec3& colour) {
     }
     colour_[object.index] = colour;
     hasColour_[object.index] = 1;
-}
-
-void Engine::beginVisibleLists() {
-    ++frameSerial_;
-    if (frameSerial_ == 0) {  // wrapped after 2^32 frames: no slot may look drawn this frame
-        std::fill(visibleFrame_.begin(), visibleFrame_.end(), 0u);
-        frameSerial_ = 1;
-    }
-    visibleFrame_.resize(objects_.slotCount(), 0);
-    visibleParts_.clear();
-    visibleObjects_.clear();
-}
-
-bool Engine::isVisible(ObjectHandle object) const {
-    return objects_.alive(object) && object.index < visibleFrame_.size() && visibleFrame_[object.index] == frameSerial_;
 }
 
 LooseBspFrameStats Engine::updateSceneTree() {
@@ -153,21 +211,29 @@ LooseBspFrameStats Engine::updateSceneTree() {
     return tree_.update(objects_);
 }
 
-Expected<FrameStats> Engine::renderFrame(QueryScheduler& scheduler) {
-    beginVisibleLists();  // a refused frame draws nothing
+Expected<FrameStats> Engine::renderView(ViewId id) {
+    View* v = findView(id);
+    if (!v) return unknownView("renderView", id);
+    return cullAndDraw(*v, *v->scheduler);
+}
+
+Expected<FrameStats> Engine::renderFrame(QueryScheduler& scheduler) { return cullAndDraw(views_[kMainView], scheduler); }
+
+Expected<FrameStats> Engine::cullAndDraw(View& view, QueryScheduler& scheduler) {
+    view.visible.begin(objects_.slotCount());  // a refused frame draws nothing
     if (Status s = checkDrawer("renderFrame"); !s) return s.error();
     if (Status s = enterGl("renderFrame"); !s) return s.error();
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();
-    const double updateMs = updateSceneTree().updateMs;
+    const double updateMs = updateSceneTree().updateMs;  // once per frame: later views find nothing moved
 
     detail::GlStateScope scope;
     const FrameTarget& target = scope.target();
     backend_->setTarget(target);
-    if (renderer_) renderer_->beginFrame(camera_);
-    Sink sink(*this);
+    if (renderer_) renderer_->beginFrame(view.camera);
+    Sink sink(*this, view.visible);
     TwoLevelTree tree(tree_, objects_);
-    FrameStats st = scheduler.cullFrame(tree, camera_, target.width(), target.height(), *backend_, sink);
+    FrameStats st = scheduler.cullFrame(tree, view.camera, target.width(), target.height(), *backend_, sink);
     if (renderer_) renderer_->endFrame();
     if (finishEachFrame_) glFinish();
     scope.restore();
@@ -180,15 +246,16 @@ Expected<FrameStats> Engine::renderFrame(QueryScheduler& scheduler) {
 }
 
 Expected<FrameStats> Engine::renderParts(const std::vector<NodeRef>& parts) {
-    beginVisibleLists();
+    View& view = views_[kMainView];
+    view.visible.begin(objects_.slotCount());
     if (Status s = checkDrawer("renderParts"); !s) return s.error();
     if (Status s = enterGl("renderParts"); !s) return s.error();
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();
     const double updateMs = updateSceneTree().updateMs;
     detail::GlStateScope scope;
-    if (renderer_) renderer_->beginFrame(camera_);
-    Sink sink(*this);
+    if (renderer_) renderer_->beginFrame(view.camera);
+    Sink sink(*this, view.visible);
     FrameStats st;
     const auto tDraw = Clock::now();
     for (const NodeRef& ref : parts) {

@@ -310,9 +310,13 @@ TEST(Embedding, WrongOrNoContextIsAnErrorAtOnce) {
 }
 
 TEST(Embedding, GlErrorsRaisedInsideAFrameComeBackAsErrors) {
-    auto ctx = test::headless();
-    ASSERT_TRUE(ctx);
     // Not a debug context: a debug one would print the deliberate errors.
+    ContextOptions quiet;
+    quiet.width = test::kW;
+    quiet.height = test::kH;
+    auto made = GlContext::create(quiet);
+    ASSERT_TRUE(made.ok()) << made.error().message;
+    std::unique_ptr<GlContext> ctx = made.take();
     GameScene scene(*ctx);
     ASSERT_TRUE(scene.engine);
     Engine& engine = *scene.engine;
@@ -369,6 +373,76 @@ TEST(Embedding, WithoutThePartRendererTheGameDrawsThePartsItIsTold) {
     EXPECT_TRUE(engine.isVisible(b));
     EXPECT_FALSE(engine.isVisible(gone));
     EXPECT_EQ(engine.visibleObjects().size(), 2u);
+    EXPECT_EQ(ctx->checkErrors(), 0u);
+}
+
+// Two views of one scene side by side (split screen): each has its own camera, history and
+// visible lists, and draws in its half exactly what it draws alone.
+TEST(Embedding, TwoViewsOfOneSceneDrawSideBySide) {
+    auto ctx = test::headless();
+    ASSERT_TRUE(ctx);
+    GameScene scene(*ctx);
+    ASSERT_TRUE(scene.engine);
+    Engine& engine = *scene.engine;
+    SchedulerParams queries;  // hardware queries: a box wholly behind the wall is culled at once
+    queries.mode = CullMode::Queries;
+    ASSERT_TRUE(engine.setSchedulerParams(queries).ok());
+    Camera behind = test::cameraOnZ(-3.0f);  // from the other side of the wall
+    behind.aspect = float(kGameW / 2) / float(kGameH);
+    auto second = engine.addView(behind, queries);
+    ASSERT_TRUE(second.ok()) << second.error().message;
+    const ViewId back = *second;
+    SchedulerParams invalid = queries;
+    invalid.maxQueriesInFlight = 0;
+    EXPECT_FALSE(engine.addView(behind, invalid).ok());
+
+    GameFramebuffer fb;
+    auto drawAlone = [&](ViewId view, bool left) {
+        fb.clear();
+        glBindFramebuffer(GL_FRAMEBUFFER, fb.fbo);
+        glViewport(left ? 0 : kGameW / 2, 0, kGameW / 2, kGameH);
+        EXPECT_TRUE(engine.renderView(view).ok());
+        std::vector<glm::u8vec4> rgba;
+        std::vector<float> depth;
+        fb.read(rgba, depth);
+        return rgba;
+    };
+    for (int warm = 0; warm < 3; ++warm) {  // histories settle
+        (void)drawAlone(kMainView, true);
+        (void)drawAlone(back, false);
+    }
+    const auto mainAlone = drawAlone(kMainView, true), backAlone = drawAlone(back, false);
+
+    fb.clear();
+    glBindFramebuffer(GL_FRAMEBUFFER, fb.fbo);
+    glViewport(0, 0, kGameW / 2, kGameH);
+    ASSERT_TRUE(engine.renderFrame().ok());
+    glViewport(kGameW / 2, 0, kGameW / 2, kGameH);
+    ASSERT_TRUE(engine.renderView(back).ok());
+    std::vector<glm::u8vec4> both;
+    std::vector<float> depth;
+    fb.read(both, depth);
+    std::uint64_t leftDiffers = 0, rightDiffers = 0;
+    for (int y = 0; y < kGameH; ++y)
+        for (int x = 0; x < kGameW / 2; ++x) {
+            const std::size_t l = std::size_t(y) * kGameW + x, r = l + kGameW / 2;
+            leftDiffers += both[l] != mainAlone[l];
+            rightDiffers += both[r] != backAlone[r];
+        }
+    EXPECT_EQ(leftDiffers, 0u);
+    EXPECT_EQ(rightDiffers, 0u);
+    // Each view sees its own side of the wall.
+    EXPECT_TRUE(engine.isVisible(scene.front, kMainView));
+    EXPECT_FALSE(engine.isVisible(scene.hidden, kMainView));
+    EXPECT_TRUE(engine.isVisible(scene.hidden, back));
+    EXPECT_FALSE(engine.isVisible(scene.front, back));
+    EXPECT_EQ(engine.camera(back).position, behind.position);
+
+    ASSERT_TRUE(engine.removeView(back).ok());
+    EXPECT_FALSE(engine.renderView(back).ok());
+    EXPECT_FALSE(engine.removeView(back).ok());
+    EXPECT_FALSE(engine.removeView(kMainView).ok());
+    EXPECT_TRUE(engine.visibleParts(back).empty());
     EXPECT_EQ(ctx->checkErrors(), 0u);
 }
 

@@ -57,9 +57,19 @@ struct VisiblePart {
     std::uint32_t indexCount = 0;
 };
 
+/// A view of the scene (Engine::addView); the main view, 0, always exists.
+using ViewId = std::uint32_t;
+inline constexpr ViewId kMainView = 0;
+
 /// Borrows the GL context, which must outlive the Engine (a game's own context is wrapped
 /// with GlContext::borrowCurrent). Each frame it draws into the framebuffer and viewport the
 /// caller has bound and leaves the caller's GL state as it found it (frame_contract.hpp).
+///
+/// Views: one scene (objects, models, the loose BSP) is seen by any number of views, each
+/// with its own camera, scheduler (mode, parameters, visibility history) and visible lists:
+/// split screen, a second camera, a shadow-map pass. Each is drawn by renderView into
+/// whatever framebuffer and viewport are bound; the scene tree is relinked once per frame
+/// however many views render.
 ///
 /// Threads: an Engine is used from one thread at a time, the one its context is current on;
 /// calls that touch GL (create, addModel, renderFrame, renderParts, the destructor) check
@@ -84,9 +94,16 @@ public:
     Status removeObject(ObjectHandle object);
     /// Rejects NaN/Inf, zero scale and non-unit rotations with an error; the object keeps its old transform.
     Status setTransform(ObjectHandle object, const Transform& transform);
-    /// Rejects invalid cameras (validateCamera); the aspect should match the framebuffer.
-    Status setCamera(const Camera& camera);
-    Status setSchedulerParams(const SchedulerParams& params);
+    /// Rejects invalid cameras (validateCamera); the aspect should match the viewport the
+    /// view is drawn into. Errors also for an unknown or removed view.
+    Status setCamera(const Camera& camera) { return setCamera(kMainView, camera); }
+    Status setCamera(ViewId view, const Camera& camera);
+    Status setSchedulerParams(const SchedulerParams& params) { return setSchedulerParams(kMainView, params); }
+    Status setSchedulerParams(ViewId view, const SchedulerParams& params);
+    /// A new view with its own camera and scheduler. Errors: invalid camera or parameters.
+    Expected<ViewId> addView(const Camera& camera, const SchedulerParams& params = {});
+    /// Removes a view (not the main one); its id stays invalid. Errors: unknown view.
+    Status removeView(ViewId view);
     void setQueryParams(const GlQueryParams& params) { backend_->setParams(params); }
     /// Replaces dyncull's renderer for parts (nullptr restores it).
     void setDrawCallback(DrawPartCallback callback) { callback_ = std::move(callback); }
@@ -101,23 +118,25 @@ public:
     /// the same error and does no GL work, see GlContext::checkReset); a GL error raised
     /// during the frame, by dyncull or the draw callback (GlError); the query volume buffers
     /// could not be allocated (the frame was still drawn, its unissued queries counted visible).
-    Expected<FrameStats> renderFrame() { return renderFrame(scheduler_); }
-    /// The same with another scheduler (its own mode, parameters and visibility history),
-    /// so several configurations can be run interleaved over the same frames of one scene.
+    Expected<FrameStats> renderFrame() { return renderView(kMainView); }
+    /// The same for another view (errors as above, and BadArgument for an unknown view).
+    Expected<FrameStats> renderView(ViewId view);
+    /// The main view with another scheduler (its own mode, parameters and visibility
+    /// history), so several configurations can be run interleaved over the same frames.
     Expected<FrameStats> renderFrame(QueryScheduler& scheduler);
     /// Draws exactly `parts` (local-BSP nodes: object slot, node), in the given order, with
     /// no culling and no queries, timed like renderFrame (the oracle lower bound of `dyncull
     /// bench`). Every ref must name a live object and a node of its model. Errors: context lost.
     Expected<FrameStats> renderParts(const std::vector<NodeRef>& parts);
-    /// The parts the last renderFrame or renderParts drew, in the order drawn (front to back
-    /// within each pass); empty after a frame that returned an error before drawing. Valid
-    /// until the next frame.
-    std::span<const VisiblePart> visibleParts() const { return visibleParts_; }
-    /// The objects with a part among visibleParts(), each once, in the order of their first
-    /// part: what a game that draws whole objects draws (conservative modes miss none).
-    std::span<const ObjectHandle> visibleObjects() const { return visibleObjects_; }
-    /// True if `object` is among visibleObjects(); false for a stale handle. O(1).
-    bool isVisible(ObjectHandle object) const;
+    /// The parts the view's last frame drew (renderFrame/renderParts for the main view), in
+    /// the order drawn (front to back within each pass); empty after a frame that returned
+    /// an error before drawing, and for an unknown view. Valid until the view's next frame.
+    std::span<const VisiblePart> visibleParts(ViewId view = kMainView) const;
+    /// The objects with a part among visibleParts(view), each once, in the order of their
+    /// first part: what a game that draws whole objects draws (conservative modes miss none).
+    std::span<const ObjectHandle> visibleObjects(ViewId view = kMainView) const;
+    /// True if `object` is among visibleObjects(view); false for a stale handle. O(1).
+    bool isVisible(ObjectHandle object, ViewId view = kMainView) const;
     /// Relinks moved objects now (renderFrame does it too; calling twice costs nothing).
     LooseBspFrameStats updateSceneTree();
     /// See EngineOptions::finishEachFrame.
@@ -129,7 +148,8 @@ public:
     const SceneObjects& objects() const { return objects_; }
     const LooseBsp& sceneTree() const { return tree_; }
     const LocalBsp& model(ModelId id) const { return objects_.model(id); }
-    const Camera& camera() const { return camera_; }
+    /// The view's camera (the main view's for an unknown view).
+    const Camera& camera(ViewId view = kMainView) const;
     /// dyncull's part renderer; only with EngineOptions::partRenderer.
     Renderer& renderer() {
         assert(renderer_ && "EngineOptions::partRenderer is off");
@@ -137,12 +157,31 @@ public:
     }
     bool hasRenderer() const { return renderer_ != nullptr; }
     GlContext& context() { return context_; }
-    QueryScheduler& scheduler() { return scheduler_; }
+    /// The view's scheduler (the main view's for an unknown view).
+    QueryScheduler& scheduler(ViewId view = kMainView);
     GlQueryBackend& queryBackend() { return *backend_; }
 
 private:
     Engine(GlContext& context, const EngineOptions& options);
     struct Sink;
+    /// What a frame drew, with a per-slot stamp so membership is O(1).
+    struct VisibleLists {
+        std::vector<VisiblePart> parts;
+        std::vector<ObjectHandle> objects;
+        std::vector<std::uint32_t> stamp;  // per object slot: `serial` of the last frame that drew it
+        std::uint32_t serial = 0;          // frames of this view so far
+        void begin(std::uint32_t slots);
+    };
+    struct View {
+        Camera camera;
+        std::unique_ptr<QueryScheduler> scheduler;
+        VisibleLists visible;
+        bool live = true;
+    };
+    View* findView(ViewId id);
+    const View* findView(ViewId id) const;
+    /// One frame of `view` with `scheduler`, into the bound framebuffer and viewport.
+    Expected<FrameStats> cullAndDraw(View& view, QueryScheduler& scheduler);
     /// Before a call's GL work: the context is current and not lost; the caller's pending
     /// GL errors are set aside (callerGlErrors_).
     Status enterGl(const char* what);
@@ -157,18 +196,11 @@ private:
     SceneObjects objects_;
     LooseBsp tree_;
     bool treeBuilt_ = false;
-    QueryScheduler scheduler_;
-    Camera camera_;
+    std::vector<View> views_;  // [kMainView] always live
     std::vector<MeshId> meshOfModel_;
     std::vector<glm::vec3> colour_;  // per object slot
     std::vector<std::uint8_t> hasColour_;
     DrawPartCallback callback_;
-    std::vector<VisiblePart> visibleParts_;
-    std::vector<ObjectHandle> visibleObjects_;
-    std::vector<std::uint32_t> visibleFrame_;  // per object slot: frameSerial_ of the last frame that drew it
-    std::uint32_t frameSerial_ = 0;            // frames rendered so far (renderFrame and renderParts)
-    /// Starts a frame's visible lists.
-    void beginVisibleLists();
     bool finishEachFrame_ = false;
     std::uint64_t callerGlErrors_ = 0;
 };
