@@ -21,7 +21,25 @@ ModelId SceneObjects::addModel(LocalBsp bsp) {
     // Cache-loaded or hand-made trees arrive without volumes; every model has them after this.
     if (bsp.volumes.nodeCount() != bsp.nodes.size()) bsp.volumes = buildNodeVolumes(bsp.mesh, bsp.nodes);
     models_.push_back(std::make_unique<LocalBsp>(std::move(bsp)));
+    modelAlive_.push_back(1);
     return static_cast<ModelId>(models_.size() - 1);
+}
+
+Status SceneObjects::removeModel(ModelId id) {
+    if (!modelAlive(id)) return Error{"removeModel: unknown or removed model " + std::to_string(id)};
+    std::uint32_t users = 0;
+    for (std::uint32_t i = 0; i < slotCount(); ++i) users += alive_[i] && model_[i] == id;
+    if (users > 0)
+        return Error{"removeModel: model " + std::to_string(id) + " is used by " + std::to_string(users) +
+                     " objects; remove them or give them another model first"};
+    // An empty single-leaf BSP keeps model(id) valid for code that walks every id.
+    LocalBsp empty;
+    empty.mesh.name = models_[id]->mesh.name;
+    empty.nodes.emplace_back();
+    empty.volumes = buildNodeVolumes(empty.mesh, empty.nodes);
+    *models_[id] = std::move(empty);
+    modelAlive_[id] = 0;
+    return {};
 }
 
 // Validates the transform and computes matrix + world box; shared by add and setTransform
@@ -40,6 +58,7 @@ Expected<ObjectHandle> SceneObjects::addObject(ModelId model, const Transform& t
     if (model >= models_.size())
         return Error{"addObject: unknown model id " + std::to_string(model) + " (" +
                      std::to_string(models_.size()) + " models)"};
+    if (!modelAlive_[model]) return Error{"addObject: model " + std::to_string(model) + " was removed"};
     glm::mat4 m;
     Aabb box;
     if (Status s = placement(*models_[model], transform, m, box); !s)
@@ -106,6 +125,19 @@ Status SceneObjects::setTransform(ObjectHandle h, const Transform& transform) {
         moved_.push_back(i);
     }
     return {};
+}
+
+Expected<ObjectHandle> SceneObjects::setModel(ObjectHandle h, ModelId model) {
+    if (!alive(h)) return Error{"setModel: stale or invalid " + handleText(h)};
+    if (!modelAlive(model)) return Error{"setModel: unknown or removed model " + std::to_string(model)};
+    glm::mat4 m;
+    Aabb box;
+    if (Status s = placement(*models_[model], transform_[h.index], m, box); !s) return Error{"setModel: " + s.message()};
+    // Remove and add: the slot is reused at once, under the next generation.
+    const Transform transform = transform_[h.index];
+    const bool isStatic = static_[h.index] != 0;
+    if (Status s = removeObject(h); !s) return s.error();
+    return addObject(model, transform, isStatic);
 }
 
 void SceneObjects::clearMoved() {

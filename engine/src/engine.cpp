@@ -167,7 +167,27 @@ Expected<ObjectHandle> Engine::addObject(ModelId model, const Transform& transfo
     return objects_.addObject(model, transform, isStatic);
 }
 
-Status Engine::removeObject(ObjectHandle object) { return objects_.removeObject(object); }
+Status Engine::removeObject(ObjectHandle object) {
+    if (Status s = objects_.removeObject(object); !s) return s;
+    if (object.index < hasColour_.size()) hasColour_[object.index] = 0;  // the next object of the slot starts afresh
+    return {};
+}
+
+Status Engine::removeModel(ModelId model) {
+    if (renderer_) {
+        if (Status s = enterGl("removeModel"); !s) return s;
+    }
+    if (Status s = objects_.removeModel(model); !s) return s;
+    if (renderer_) {
+        renderer_->release(meshOfModel_[model]);
+        if (Status s = leaveGl("removeModel"); !s) return s;
+    }
+    return {};
+}
+
+Expected<ObjectHandle> Engine::setModel(ObjectHandle object, ModelId model) {
+    return objects_.setModel(object, model);  // same slot, so the object keeps its colour
+}
 
 Status Engine::setTransform(ObjectHandle object, const Transform& transform) {
     return objects_.setTransform(object, transform);

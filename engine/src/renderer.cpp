@@ -47,6 +47,16 @@ Renderer::~Renderer() {
         if (p.id) glDeleteProgram(p.id);
 }
 
+void Renderer::release(MeshId id) {
+    assert(id < meshes_.size());
+    GpuMesh& m = meshes_[id];
+    glDeleteVertexArrays(1, &m.vao);  // 0 names are ignored: releasing twice is harmless
+    glDeleteBuffers(1, &m.vbo);
+    glDeleteBuffers(1, &m.ibo);
+    uploadedBytes_ -= m.bytes;
+    m = GpuMesh{};
+}
+
 Expected<MeshId> Renderer::upload(const Mesh& mesh, FaceMode faces) {
     assert(validateMesh(mesh).empty());
     Mesh withNormals;
@@ -96,6 +106,7 @@ Expected<MeshId> Renderer::upload(const Mesh& mesh, FaceMode faces) {
     glVertexArrayAttribFormat(g.vao, 1, 3, GL_FLOAT, GL_FALSE, sizeof(glm::vec3));
     glVertexArrayAttribBinding(g.vao, 1, 0);
     uploadedBytes_ += totalBytes;
+    g.bytes = totalBytes;
     meshes_.push_back(g);
     return static_cast<MeshId>(meshes_.size() - 1);
 }

@@ -125,3 +125,33 @@ TEST(SceneObjects, PlacementSerialsMarkMovesAndSlotReuse) {
     ASSERT_EQ(c.index, b.index);
     EXPECT_NE(so.placedAt(c.index), b0);
 }
+
+// A model in use cannot be removed; a removed model's id stays refused; setModel moves an
+// object to another model under a new handle, keeping its transform and static flag.
+TEST(SceneObjects, ModelsAreRemovedOnlyWhenUnusedAndObjectsChangeModel) {
+    SceneObjects so;
+    const ModelId small = so.addModel(test::cubeModel(0.5f));
+    const ModelId big = so.addModel(test::cubeModel(2.0f));
+    const ObjectHandle h = so.addObject(small, at({1, 2, 3}), true).take();
+    const Status inUse = so.removeModel(small);
+    ASSERT_FALSE(inUse.ok());
+    EXPECT_NE(inUse.message().find("used by 1"), std::string::npos) << inUse.message();
+
+    auto moved = so.setModel(h, big);
+    ASSERT_TRUE(moved.ok()) << moved.error().message;
+    EXPECT_FALSE(so.alive(h));  // the old handle is stale
+    ASSERT_TRUE(so.alive(*moved));
+    EXPECT_EQ(so.modelOf(moved->index), big);
+    EXPECT_EQ(so.transform(moved->index).translation, glm::vec3(1, 2, 3));
+    EXPECT_TRUE(so.isStatic(moved->index));
+    EXPECT_FLOAT_EQ(so.worldBox(moved->index).max.x - so.worldBox(moved->index).min.x, 4.0f);
+
+    ASSERT_TRUE(so.removeModel(small).ok());
+    EXPECT_FALSE(so.modelAlive(small));
+    EXPECT_FALSE(so.removeModel(small).ok());
+    EXPECT_FALSE(so.addObject(small, at({0, 0, 0})).ok());
+    EXPECT_FALSE(so.setModel(*moved, small).ok());
+    EXPECT_FALSE(so.setModel(h, big).ok());
+    EXPECT_EQ(so.modelCount(), 2u);  // ids are not reused
+    EXPECT_EQ(so.model(small).nodes.size(), 1u);
+}

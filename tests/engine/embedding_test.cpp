@@ -446,6 +446,64 @@ TEST(Embedding, TwoViewsOfOneSceneDrawSideBySide) {
     EXPECT_EQ(ctx->checkErrors(), 0u);
 }
 
+// Lifecycle between frames: an object changes model (new handle), a model is removed once
+// unused, and the viewport shrinks; every frame of the default mode still draws what vfc
+// draws.
+TEST(Embedding, ModelsChangeAndTheViewportResizesBetweenFrames) {
+    auto ctx = test::headless();
+    ASSERT_TRUE(ctx);
+    GameScene scene(*ctx);
+    ASSERT_TRUE(scene.engine);
+    Engine& engine = *scene.engine;
+    SchedulerParams vfcParams;
+    vfcParams.mode = CullMode::Vfc;
+    QueryScheduler vfc(vfcParams);
+    GameFramebuffer fb;
+    // The main view (two-phase) and vfc into the same viewport must give the same picture.
+    auto expectLikeVfc = [&](int w, int h, const char* when) {
+        Camera cam = engine.camera();
+        cam.aspect = float(w) / float(h);
+        ASSERT_TRUE(engine.setCamera(cam).ok());
+        std::vector<glm::u8vec4> full, reference;
+        std::vector<float> depth;
+        for (int frame = 0; frame < 3; ++frame) {
+            fb.clear();
+            glBindFramebuffer(GL_FRAMEBUFFER, fb.fbo);
+            glViewport(0, 0, w, h);
+            auto st = engine.renderFrame();
+            ASSERT_TRUE(st.ok()) << st.error().message;
+        }
+        fb.read(full, depth);
+        fb.clear();
+        glBindFramebuffer(GL_FRAMEBUFFER, fb.fbo);
+        glViewport(0, 0, w, h);
+        ASSERT_TRUE(engine.renderFrame(vfc).ok());
+        fb.read(reference, depth);
+        EXPECT_EQ(full, reference) << when;
+    };
+    expectLikeVfc(kGameW, kGameH, "at first");
+
+    const ModelId box = *engine.addModel(test::cubeMesh(0.25f));
+    const ModelId ball = engine.objects().modelOf(scene.front.index);
+    auto moved = engine.setModel(scene.front, box);
+    ASSERT_TRUE(moved.ok()) << moved.error().message;
+    EXPECT_FALSE(engine.objects().alive(scene.front));
+    const Status inUse = engine.removeModel(ball);
+    EXPECT_FALSE(inUse.ok());
+    EXPECT_EQ(inUse.code(), ErrorCode::BadArgument);
+    auto hiddenMoved = engine.setModel(scene.hidden, box);
+    ASSERT_TRUE(hiddenMoved.ok());
+    ASSERT_TRUE(engine.removeModel(ball).ok());
+    EXPECT_FALSE(engine.addObject(ball, at({0, 0, 0})).ok());
+    expectLikeVfc(kGameW, kGameH, "after the model changes");
+    EXPECT_TRUE(engine.isVisible(*moved));
+    EXPECT_FALSE(engine.isVisible(scene.front));  // stale handle
+
+    expectLikeVfc(kGameW / 2, kGameH / 2, "after the viewport shrank");
+    expectLikeVfc(kGameW, kGameH, "after it grew back");
+    EXPECT_EQ(ctx->checkErrors(), 0u);
+}
+
 // A game's own context, wrapped: two engines (split screen) draw into its framebuffer side
 // by side, and dropping the wrapper leaves the game's context working.
 TEST(Embedding, TwoEnginesOnABorrowedContextDrawSideBySide) {

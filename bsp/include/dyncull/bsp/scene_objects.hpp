@@ -33,7 +33,18 @@ public:
     /// nodes' query volumes when the BSP has none (e.g. loaded from a cache).
     ModelId addModel(LocalBsp bsp);
     const LocalBsp& model(ModelId id) const { return *models_[id]; }
+    /// Ids ever given out, removed ones included (a removed model is an empty BSP).
     std::size_t modelCount() const { return models_.size(); }
+    bool modelAlive(ModelId id) const { return id < models_.size() && modelAlive_[id] != 0; }
+    /// Frees a model no live object uses; its id is never given out again. Errors: unknown
+    /// or removed model, or objects still using it (remove them or give them another model).
+    Status removeModel(ModelId id);
+    /// Gives an object another model, keeping its transform and static flag. The object
+    /// comes back under a new handle (the old one is stale from now on), because everything
+    /// kept per object downstream (visibility histories, pending queries) names the old
+    /// model's nodes. Errors: stale handle, unknown or removed model, a model whose box the
+    /// object's transform cannot place.
+    Expected<ObjectHandle> setModel(ObjectHandle h, ModelId model);
 
     /// Adds an instance. Errors on an unknown model or an invalid transform. A static object
     /// promises never to move: setTransform refuses it, and it costs nothing per frame (no
@@ -70,6 +81,7 @@ public:
 
 private:
     std::vector<std::unique_ptr<LocalBsp>> models_;  // stable addresses: renderer caches per model
+    std::vector<std::uint8_t> modelAlive_;
     std::vector<ModelId> model_;
     std::vector<glm::mat4> matrix_;
     std::vector<Transform> transform_;

@@ -90,8 +90,17 @@ public:
     Expected<ModelId> addModel(const Mesh& mesh, const LocalBspParams& params = {});
     /// Adds a prebuilt local BSP (e.g. loaded from a cache); errors as above.
     Expected<ModelId> addModel(LocalBsp bsp);
+    /// Adds an instance of a model (see SceneObjects::addObject: a static object never moves
+    /// and costs nothing per frame).
     Expected<ObjectHandle> addObject(ModelId model, const Transform& transform, bool isStatic = false);
     Status removeObject(ObjectHandle object);
+    /// Frees a model no object uses, with its GPU copy (part renderer). To replace a model:
+    /// add the new one, move its objects over with setModel, remove the old one.
+    /// Errors: unknown or removed model, objects still using it, the context not current.
+    Status removeModel(ModelId model);
+    /// Gives an object another model; it comes back under a new handle, the old one stale
+    /// (SceneObjects::setModel). Errors: stale handle, unknown or removed model.
+    Expected<ObjectHandle> setModel(ObjectHandle object, ModelId model);
     /// Rejects NaN/Inf, zero scale and non-unit rotations with an error; the object keeps its old transform.
     Status setTransform(ObjectHandle object, const Transform& transform);
     /// Rejects invalid cameras (validateCamera); the aspect should match the viewport the

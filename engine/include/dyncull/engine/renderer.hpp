@@ -57,6 +57,8 @@ public:
     /// keeps nothing: buffers made for it are deleted, meshCount() is unchanged.
     Expected<MeshId> upload(const Mesh& mesh, FaceMode faces = FaceMode::TwoSided);
     std::uint32_t indexCount(MeshId id) const { return meshes_[id].indexCount; }
+    /// Deletes the mesh's buffers; its id is not reused and must not be drawn again.
+    void release(MeshId id);
     std::size_t meshCount() const { return meshes_.size(); }
     /// GPU memory held by mesh buffers, bytes.
     std::size_t uploadedBytes() const { return uploadedBytes_; }
@@ -109,6 +111,7 @@ private:
     struct GpuMesh {
         std::uint32_t vao = 0, vbo = 0, ibo = 0;
         std::uint32_t indexCount = 0;
+        std::size_t bytes = 0;
         bool cullBack = false;
     };
     struct LitProgram {
