@@ -198,4 +198,23 @@ Expected<LocalBsp> buildLocalBsp(const Mesh& mesh, const LocalBspParams& params)
     return bsp;
 }
 
+Expected<LocalBsp> buildBoundsModel(const Aabb& bounds, std::uint32_t triangles) {
+    if (bounds.empty() || !bounds.finite()) return Error{"buildBoundsModel: the bounds are empty or not finite"};
+    if (triangles == 0) return Error{"buildBoundsModel: a draw costs at least one triangle"};
+    Mesh box;
+    box.name = "bounds";
+    for (int i = 0; i < 8; ++i)
+        box.positions.push_back({i & 1 ? bounds.max.x : bounds.min.x, i & 2 ? bounds.max.y : bounds.min.y,
+                                 i & 4 ? bounds.max.z : bounds.min.z});
+    // Two counter-clockwise (outward) triangles per face: -x, +x, -y, +y, -z, +z.
+    box.indices = {0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5, 0, 1, 5, 0, 5, 4,
+                   2, 6, 7, 2, 7, 3, 0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6};
+    LocalBspParams single;
+    single.maxLeafTriangles = 12;  // one leaf: the whole object is one part
+    auto bsp = buildLocalBsp(box, single);
+    if (!bsp) return bsp.error();
+    bsp->drawTriangles = triangles;
+    return bsp;
+}
+
 }  // namespace dyncull

@@ -147,6 +147,12 @@ Expected<ModelId> Engine::addModel(const Mesh& mesh, const LocalBspParams& param
     return addModel(bsp.take());
 }
 
+Expected<ModelId> Engine::addBoundsModel(const Aabb& bounds, std::uint32_t triangles) {
+    auto bsp = buildBoundsModel(bounds, triangles);
+    if (!bsp) return bsp.error();
+    return addModel(bsp.take());
+}
+
 Expected<ModelId> Engine::addModel(LocalBsp bsp) {
     if (Status s = enterGl("adding a model"); !s) return s.error();
     // Upload first: if the GPU refuses, nothing has been registered yet.

@@ -235,7 +235,10 @@ bool QueryScheduler::worthTesting(NodeRef ref, const ScreenRect& rect, double oc
 std::uint64_t QueryScheduler::subtreeTriangles(NodeRef ref) {
     const SceneObjects& objs = tree_->objects();
     auto objectTriangles = [&](std::uint32_t object, std::uint32_t node) {
-        return std::uint64_t{objs.model(objs.modelOf(object)).nodes[node].indexCount / 3};
+        const LocalBsp& model = objs.model(objs.modelOf(object));
+        // A bounds model's one part is the game's whole object: count what drawing it costs.
+        if (model.drawTriangles > 0) return std::uint64_t{model.drawTriangles};
+        return std::uint64_t{model.nodes[node].indexCount / 3};
     };
     if (!ref.isSceneNode()) return objectTriangles(ref.object, ref.node);
     const LooseBsp& scene = tree_->scene();

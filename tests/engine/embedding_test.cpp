@@ -504,6 +504,43 @@ TEST(Embedding, ModelsChangeAndTheViewportResizesBetweenFrames) {
     EXPECT_EQ(ctx->checkErrors(), 0u);
 }
 
+// Objects given by their bounds only: the game draws each whole when dyncull says it is
+// visible. One behind the wall costing a million triangles is tested and culled (the
+// cost model counts what its draw costs, not its box's 12 triangles); one in front is
+// drawn. (The part renderer draws the wall and, for the bounds objects, their boxes.)
+TEST(Embedding, BoundsOnlyObjectsAreCulledAndDrawnWhole) {
+    auto ctx = test::headless();
+    ASSERT_TRUE(ctx);
+    auto made = Engine::create(*ctx);
+    ASSERT_TRUE(made.ok()) << made.error().message;
+    Engine& engine = **made;
+    const ModelId quad = *engine.addModel(test::quadMesh(1.0f));
+    auto heavyModel = engine.addBoundsModel(Aabb::fromMinMax(glm::vec3(-0.3f), glm::vec3(0.3f)), 1000000);
+    ASSERT_TRUE(heavyModel.ok()) << heavyModel.error().message;
+    EXPECT_FALSE(engine.addBoundsModel(Aabb{}, 10).ok());
+    EXPECT_FALSE(engine.addBoundsModel(Aabb::fromMinMax(glm::vec3(0), glm::vec3(1)), 0).ok());
+    ASSERT_TRUE(engine.addObject(quad, at({0, 0, 0})).ok());
+    const ObjectHandle behind = *engine.addObject(*heavyModel, at({0, 0, -1.5f}));
+    const ObjectHandle inFront = *engine.addObject(*heavyModel, at({0.4f, 0.4f, 1.0f}));
+    ASSERT_TRUE(engine.setCamera(test::cameraOnZ(3.0f)).ok());
+    for (int frame = 0; frame < 6; ++frame) {
+        ctx->clearFramebuffer(Renderer::kClearColour);
+        auto st = engine.renderFrame();
+        ASSERT_TRUE(st.ok()) << st.error().message;
+    }
+    EXPECT_TRUE(engine.isVisible(inFront));
+    EXPECT_FALSE(engine.isVisible(behind));
+    std::uint32_t wholeDraws = 0;
+    for (const VisiblePart& p : engine.visibleParts())
+        if (engine.objects().modelOf(p.part.object) == *heavyModel) {
+            ++wholeDraws;
+            EXPECT_EQ(p.object, inFront);
+            EXPECT_EQ(p.firstIndex, 0u);
+            EXPECT_EQ(p.indexCount, 36u);  // the box's range: a game draws its own object instead
+        }
+    EXPECT_EQ(wholeDraws, 1u);
+}
+
 // A game's own context, wrapped: two engines (split screen) draw into its framebuffer side
 // by side, and dropping the wrapper leaves the game's context working.
 TEST(Embedding, TwoEnginesOnABorrowedContextDrawSideBySide) {

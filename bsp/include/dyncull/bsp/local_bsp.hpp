@@ -110,6 +110,9 @@ struct LocalBsp {
     NodeVolumes volumes;
     /// How the renderer and the ground truth draw `mesh` (see FacePolicy).
     FaceMode faces = FaceMode::TwoSided;
+    /// Triangles a draw of the whole model costs when `mesh` only stands for it (a bounds
+    /// model, buildBoundsModel), for the scheduler's cost model; 0: the mesh's own.
+    std::uint32_t drawTriangles = 0;
     LocalBspStats stats;
 
     const LocalBspNode& root() const { return nodes[0]; }
@@ -127,6 +130,13 @@ struct LocalBsp {
 /// maxLeafTriangles == 0, maxDepth > kLocalBspMaxDepth, nudgeFraction not in [0, 0.5].
 /// An empty mesh gives a single empty leaf.
 Expected<LocalBsp> buildLocalBsp(const Mesh& mesh, const LocalBspParams& params = {});
+
+/// A model for an object the game draws whole and describes by its bounds only (object
+/// space): the mesh is the box (12 outward triangles, so the part renderer can show it),
+/// the one part is the whole object, and the cost model counts `triangles` for a draw of it
+/// (what the game's object really costs). The draw callback gets the box's index range and
+/// draws its own object instead. Errors: an empty or non-finite box, or 0 triangles.
+Expected<LocalBsp> buildBoundsModel(const Aabb& bounds, std::uint32_t triangles);
 
 /// A game's per-vertex data for the input mesh (`components` floats per vertex, in vertex
 /// order: texture coordinates, tangents, colours, skinning weights...) extended to every

@@ -90,6 +90,11 @@ public:
     Expected<ModelId> addModel(const Mesh& mesh, const LocalBspParams& params = {});
     /// Adds a prebuilt local BSP (e.g. loaded from a cache); errors as above.
     Expected<ModelId> addModel(LocalBsp bsp);
+    /// A model the game describes by its object-space bounds only and draws whole when it
+    /// is visible (buildBoundsModel: `triangles` is what a draw of it costs, for the cost
+    /// model). The draw callback receives the box's index range for it; with the part
+    /// renderer the box itself is drawn. Errors: bad bounds or 0 triangles, as addModel.
+    Expected<ModelId> addBoundsModel(const Aabb& bounds, std::uint32_t triangles);
     /// Adds an instance of a model (see SceneObjects::addObject: a static object never moves
     /// and costs nothing per frame).
     Expected<ObjectHandle> addObject(ModelId model, const Transform& transform, bool isStatic = false);
