@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs dyncull from a build tree into a temporary prefix and builds every example in
-# examples/ against that installed copy, as a game would, then runs the headless one: a
+# examples/ against that installed copy, as a game would, then runs them: a
 # broken install, a missing header or a dependency the runtime component should not need
 # fails here. Usage: examples_against_install.sh BUILD_DIR SOURCE_DIR WORK_DIR
 set -euo pipefail
@@ -21,6 +21,18 @@ cmake -S "$src/examples/headless" -B "$work/headless" -DCMAKE_PREFIX_PATH="$pref
   >"$work/configure.log"
 cmake --build "$work/headless" -j2 >"$work/build.log"
 "$work/headless/headless_game" --frames 8 --cull full --check --screenshot "$work/headless_full.png"
+
+# The windowed game (its own GLFW window, textures and shader); run where a display can be
+# made (Xvfb), else only built.
+cmake -S "$src/examples/glfw_game" -B "$work/glfw_game" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release \
+  >"$work/configure_glfw.log"
+cmake --build "$work/glfw_game" -j2 >"$work/build_glfw.log"
+if command -v xvfb-run >/dev/null; then
+  xvfb-run -a "$work/glfw_game/glfw_game" --frames 30 --screenshot "$work/glfw_game.png"
+  [[ -s "$work/glfw_game.png" ]] || { echo "FAIL: glfw_game wrote no screenshot" >&2; exit 1; }
+else
+  echo "glfw_game: built; not run (no xvfb-run)"
+fi
 
 # pkg-config: the same program built with the flags dyncull.pc gives.
 PKG_CONFIG_PATH="$prefix/lib/pkgconfig:$prefix/lib/$(gcc -print-multiarch)/pkgconfig" \
