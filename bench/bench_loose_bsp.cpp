@@ -21,21 +21,28 @@ LocalBsp cube() {
     return bsp;
 }
 
-// Objects bounce in a box whose volume grows with the count (constant density), moving
-// 0.3 units per frame, all of them every frame (worst case: nothing is static).
-void BM_LooseBspFrame(benchmark::State& state) {
-    const auto count = static_cast<std::uint32_t>(state.range(0));
+// `count` unit cubes bouncing in a box whose volume grows with the count (constant
+// density), 0.3 units per frame, placed at frame 0; their handles in `handles`.
+BouncingMotion bouncingCubes(std::uint32_t count, std::uint64_t seed, bool isStatic, SceneObjects& so,
+                             std::vector<ObjectHandle>& handles) {
     const float half = 2.0f * std::cbrt(static_cast<float>(count));
-    const Aabb world = Aabb::fromMinMax(glm::vec3(-half), glm::vec3(half));
-    BouncingMotion motion(count, world, 0.3f, 1.0f, 77);
-    SceneObjects so;
+    BouncingMotion motion(count, Aabb::fromMinMax(glm::vec3(-half), glm::vec3(half)), 0.3f, 1.0f, seed);
     const ModelId m = so.addModel(cube());
-    std::vector<ObjectHandle> hs;
     Transform t;
     for (std::uint32_t i = 0; i < count; ++i) {
         t.translation = motion.position(i, 0);
-        hs.push_back(so.addObject(m, t).take());
+        handles.push_back(so.addObject(m, t, isStatic).take());
     }
+    return motion;
+}
+
+// Every object moves every frame (worst case: nothing is static).
+void BM_LooseBspFrame(benchmark::State& state) {
+    const auto count = static_cast<std::uint32_t>(state.range(0));
+    SceneObjects so;
+    std::vector<ObjectHandle> hs;
+    const BouncingMotion motion = bouncingCubes(count, 77, false, so, hs);
+    Transform t;
     LooseBsp bsp;  // default params: rebuild budget 0.5 ms per frame
     bsp.build(so);
     std::uint64_t frame = 0;
@@ -66,16 +73,9 @@ BENCHMARK(BM_LooseBspFrame)->Arg(300)->Arg(100000)->Unit(benchmark::kMillisecond
 // The same scene with every object static: nothing moves, so a frame must cost nothing
 // that grows with the object count (beside BM_LooseBspFrame's moving objects).
 void BM_LooseBspFrameStatic(benchmark::State& state) {
-    const auto count = static_cast<std::uint32_t>(state.range(0));
-    const float half = 2.0f * std::cbrt(static_cast<float>(count));
-    BouncingMotion motion(count, Aabb::fromMinMax(glm::vec3(-half), glm::vec3(half)), 0.3f, 1.0f, 77);
     SceneObjects so;
-    const ModelId m = so.addModel(cube());
-    Transform t;
-    for (std::uint32_t i = 0; i < count; ++i) {
-        t.translation = motion.position(i, 0);
-        (void)so.addObject(m, t, /*isStatic=*/true);
-    }
+    std::vector<ObjectHandle> hs;
+    (void)bouncingCubes(static_cast<std::uint32_t>(state.range(0)), 77, true, so, hs);
     LooseBsp bsp;
     bsp.build(so);
     double relinked = 0, treeMs = 0, frames = 0;
@@ -92,15 +92,9 @@ BENCHMARK(BM_LooseBspFrameStatic)->Arg(300)->Arg(100000)->Unit(benchmark::kMilli
 
 void BM_LooseBspBuild(benchmark::State& state) {
     const auto count = static_cast<std::uint32_t>(state.range(0));
-    const float half = 2.0f * std::cbrt(static_cast<float>(count));
-    BouncingMotion motion(count, Aabb::fromMinMax(glm::vec3(-half), glm::vec3(half)), 0.3f, 1.0f, 5);
     SceneObjects so;
-    const ModelId m = so.addModel(cube());
-    Transform t;
-    for (std::uint32_t i = 0; i < count; ++i) {
-        t.translation = motion.position(i, 0);
-        (void)so.addObject(m, t);
-    }
+    std::vector<ObjectHandle> hs;
+    (void)bouncingCubes(count, 5, false, so, hs);
     LooseBsp bsp;
     for (auto _ : state) bsp.build(so);
     state.counters["bytes/object"] = static_cast<double>(bsp.memoryBytes()) / count;
