@@ -21,6 +21,7 @@
 #include "dyncull/engine/engine.hpp"
 #include "dyncull/engine/image.hpp"
 #include "interactive.hpp"
+#include "report_writer.hpp"
 #include "scene_options.hpp"
 
 namespace dyncull::cli {
@@ -42,16 +43,12 @@ struct RunOptions {
     SchedulerFlags flags;
 };
 
-void writeCsvHeader(std::ofstream& f) {
-    f << "frame,ms_frame,ms_traversal,ms_query,ms_wait,ms_draw,ms_update,queries,queries_occluded,skipped_history,"
-         "skipped_occupancy,visible_near,frustum_culled,nodes_visited,batches,parts,triangles\n";
-}
+void writeCsvHeader(std::ofstream& f) { f << "frame," << frameStatsCsvHeader() << '\n'; }
 
 void writeCsvRow(std::ofstream& f, std::uint64_t frame, const FrameStats& s) {
-    f << frame << ',' << s.frameMs << ',' << s.traversalMs << ',' << s.queryMs << ',' << s.waitMs << ',' << s.drawMs << ',' << s.updateMs
-      << ',' << s.queriesIssued << ',' << s.queriesOccluded << ',' << s.skippedByHistory << ',' << s.skippedByOccupancy
-      << ',' << s.visibleNearOrInside << ',' << s.frustumCulled << ',' << s.nodesVisited << ',' << s.batches << ','
-      << s.partsDrawn << ',' << s.trianglesDrawn << '\n';
+    f << frame << ',';
+    writeFrameStatsCsv(f, s);
+    f << '\n';
 }
 
 // Node-box view of a headless frame, for screenshots: boxes, stats line and legend.

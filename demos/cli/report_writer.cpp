@@ -168,40 +168,48 @@ std::vector<ModeSummary> summarise(const BenchResult& r) {
     return out;
 }
 
+const char* frameStatsCsvHeader() {
+    return "ms_frame,ms_traversal,ms_query,ms_wait,ms_draw,ms_update,queries,queries_occluded,queries_timed_out,"
+           "skipped_history,skipped_occupancy,skipped_cost,visible_near,visible_front,frustum_culled,small_feature_culled,"
+           "nodes_visited,batches,parts,triangles,query_triangles,draw_queries,draw_queries_occluded,draw_queries_late,"
+           "depth_tests,ms_depth_read,raster_tests,raster_batches,ms_raster";
+}
+
+void writeFrameStatsCsv(std::ostream& f, const FrameStats& s) {
+    f << s.frameMs << ',' << s.traversalMs << ',' << s.queryMs << ',' << s.waitMs << ',' << s.drawMs << ',' << s.updateMs << ','
+      << s.queriesIssued << ',' << s.queriesOccluded << ',' << s.queriesTimedOut << ',' << s.skippedByHistory << ','
+      << s.skippedByOccupancy << ',' << s.skippedByCost << ',' << s.visibleNearOrInside << ',' << s.visibleFront << ','
+      << s.frustumCulled << ',' << s.smallFeatureCulled << ',' << s.nodesVisited << ',' << s.batches << ','
+      << s.partsDrawn << ',' << s.trianglesDrawn << ',' << s.queryTriangles << ',' << s.drawQueries << ','
+      << s.drawQueriesOccluded << ',' << s.drawQueriesLate << ',' << s.depthTests << ',' << s.depthReadMs << ','
+      << s.rasterTests << ',' << s.rasterBatches << ',' << s.rasterMs;
+}
+
 Status writeFramesCsv(const BenchResult& r, const fs::path& path) {
     std::ofstream f;
     if (Status s = openChecked(f, path); !s) return s;
-    f << "frame,mode,ms_frame,ms_traversal,ms_query,ms_wait,ms_draw,ms_update,queries,queries_occluded,queries_timed_out,"
-         "skipped_history,skipped_occupancy,visible_near,frustum_culled,small_feature_culled,nodes_visited,batches,"
-         "parts,triangles,visible_parts,frustum_parts,false_negatives,false_negative_pixels,false_positives,"
+    f << "frame,mode," << frameStatsCsvHeader()
+      << ",visible_parts,frustum_parts,false_negatives,false_negative_pixels,false_positives,"
          "pixels_wrong,pixels_wrong_pct,largest_wrong_region,frame_update_ms,ground_truth_ms,ground_truth_artefact_pixels,"
-         "draw_queries,draw_queries_occluded,draw_queries_late,false_positives_queried,false_positives_history,"
-         "false_positives_occupancy,false_positives_other,visible_triangles,bound_aabb_parts,bound_aabb_triangles,"
-         "bound_auto_parts,bound_auto_triangles,depth_tests,ms_depth_read,raster_tests,raster_batches,ms_raster,skipped_cost\n";
+         "false_positives_queried,false_positives_history,false_positives_occupancy,false_positives_other,"
+         "visible_triangles,bound_aabb_parts,bound_aabb_triangles,bound_auto_parts,bound_auto_triangles\n";
     for (std::size_t i = 0; i < r.frames.size(); ++i) {
         const FrameTruth& t = r.truth[i];
         for (std::size_t m = 0; m < r.modes.size(); ++m) {
-            const FrameStats& s = r.frames[i][m].stats;
             const PartErrors& p = r.frames[i][m].parts;
             const ImageDiff& d = r.frames[i][m].image;
-            f << i << ',' << r.modes[m].name << ',' << s.frameMs << ',' << s.traversalMs << ',' << s.queryMs << ',' << s.waitMs << ','
-              << s.drawMs << ',' << s.updateMs << ',' << s.queriesIssued << ',' << s.queriesOccluded << ','
-              << s.queriesTimedOut << ',' << s.skippedByHistory << ',' << s.skippedByOccupancy << ','
-              << s.visibleNearOrInside << ',' << s.frustumCulled << ',' << s.smallFeatureCulled << ','
-              << s.nodesVisited << ',' << s.batches << ',' << s.partsDrawn << ',' << s.trianglesDrawn << ','
-              << t.visibleParts << ',' << t.frustumParts << ',' << p.falseNegatives << ',' << p.falseNegativePixels
+            f << i << ',' << r.modes[m].name << ',';
+            writeFrameStatsCsv(f, r.frames[i][m].stats);
+            f << ',' << t.visibleParts << ',' << t.frustumParts << ',' << p.falseNegatives << ',' << p.falseNegativePixels
               << ',' << p.falsePositives << ',' << d.differingPixels << ',' << d.percentDiffering << ','
-              << d.largestRegion << ',' << t.updateMs << ',' << t.groundTruthMs << ',' << t.artefactPixels << ','
-              << s.drawQueries << ',' << s.drawQueriesOccluded << ',' << s.drawQueriesLate << ',';
+              << d.largestRegion << ',' << t.updateMs << ',' << t.groundTruthMs << ',' << t.artefactPixels << ',';
             const FalsePositiveCauses& c = r.frames[i][m].falsePositiveCauses;
             f << c.queried << ',' << c.history << ',' << c.occupancy << ',' << c.other << ',' << t.visibleTriangles;
             if (t.boundMeasured)
                 f << ',' << t.boundAabb.parts << ',' << t.boundAabb.triangles << ',' << t.boundAuto.parts << ','
-                  << t.boundAuto.triangles;
+                  << t.boundAuto.triangles << '\n';
             else
-                f << ",,,,";  // not measured
-            f << ',' << s.depthTests << ',' << s.depthReadMs << ',' << s.rasterTests << ',' << s.rasterBatches << ','
-              << s.rasterMs << ',' << s.skippedByCost << '\n';
+                f << ",,,,\n";  // not measured
         }
     }
     return closeChecked(f, path);

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -53,6 +54,12 @@ int findMode(const std::vector<ModeSummary>& summary, const std::string& name);
 
 /// DIR/frames.csv: one row per frame and mode with every FrameStats field and the errors.
 Status writeFramesCsv(const BenchResult& result, const std::filesystem::path& path);
+
+/// Every FrameStats field as CSV columns: the one place the frames CSVs of `dyncull run`
+/// and `dyncull bench` take them from (header names, then values in the same order; no
+/// leading or trailing comma).
+const char* frameStatsCsvHeader();
+void writeFrameStatsCsv(std::ostream& out, const FrameStats& s);
 /// DIR/summary.csv: one row per mode.
 Status writeSummaryCsv(const std::vector<ModeSummary>& summary, const std::filesystem::path& path);
 
