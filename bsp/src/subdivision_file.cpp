@@ -10,13 +10,11 @@
 #include <type_traits>
 #include <vector>
 
+#include "dyncull/objects/binary_file.hpp"
 #include "dyncull/objects/checked_write.hpp"
-#include "dyncull/objects/checksum.hpp"
 
 namespace dyncull {
 namespace {
-
-static_assert(std::endian::native == std::endian::little, "subdivision files are written in host (little-endian) order");
 
 constexpr char kMagic[8] = {'D', 'Y', 'N', 'C', 'S', 'U', 'B', '\0'};
 constexpr std::size_t kNodeBytes = 6 * 4 + 5 * 4;
@@ -24,85 +22,6 @@ constexpr std::size_t kNodeBytes = 6 * 4 + 5 * 4;
 Error bad(const std::filesystem::path& path, const std::string& why) {
     return Error{"subdivision file " + path.string() + ": " + why};
 }
-
-class Writer {
-public:
-    explicit Writer(std::ofstream& f) : f_(f) {}
-    void bytes(const void* p, std::size_t n) {
-        f_.write(static_cast<const char*>(p), static_cast<std::streamsize>(n));
-        hash_ = fnv1a64(p, n, hash_);
-        size_ += n;
-    }
-    template <class T>
-    void put(const T& v) {
-        static_assert(std::is_trivially_copyable_v<T>);
-        bytes(&v, sizeof(T));
-    }
-    template <class T>
-    void array(const std::vector<T>& v) {
-        put(static_cast<std::uint64_t>(v.size()));
-        bytes(v.data(), v.size() * sizeof(T));
-    }
-    void str(const std::string& s) {
-        put(static_cast<std::uint32_t>(s.size()));
-        bytes(s.data(), s.size());
-    }
-    std::uint64_t hash() const { return hash_; }
-    std::uint64_t size() const { return size_; }
-
-private:
-    std::ofstream& f_;
-    std::uint64_t hash_ = kFnv1a64Seed;
-    std::uint64_t size_ = 0;
-};
-
-/// Bounds-checked reader of the payload: after the first failure every read fails and
-/// yields zeros, so the parser checks once per record; counts above the bytes left fail
-/// before any allocation.
-class Reader {
-public:
-    Reader(std::ifstream& f, std::uint64_t size) : f_(f), left_(size) {}
-    bool bytes(void* p, std::size_t n) {
-        if (fail_ || n > left_) {
-            fail_ = true;
-            std::memset(p, 0, n);
-            return false;
-        }
-        f_.read(static_cast<char*>(p), static_cast<std::streamsize>(n));
-        if (!f_) {
-            fail_ = true;
-            return false;
-        }
-        left_ -= n;
-        return true;
-    }
-    template <class T>
-    T get() {
-        T v{};
-        bytes(&v, sizeof(T));
-        return v;
-    }
-    template <class T>
-    bool array(std::vector<T>& v) {
-        const auto n = get<std::uint64_t>();
-        if (fail_ || n > left_ / sizeof(T)) return fail_ = true, false;
-        v.resize(static_cast<std::size_t>(n));
-        return bytes(v.data(), v.size() * sizeof(T));
-    }
-    bool str(std::string& s, std::uint32_t maxLength) {
-        const auto n = get<std::uint32_t>();
-        if (fail_ || n > left_ || n > maxLength) return fail_ = true, false;
-        s.resize(n);
-        return bytes(s.data(), n);
-    }
-    bool failed() const { return fail_; }
-    std::uint64_t left() const { return left_; }
-
-private:
-    std::ifstream& f_;
-    std::uint64_t left_;
-    bool fail_ = false;
-};
 
 }  // namespace
 
@@ -117,8 +36,8 @@ Status writeSubdivisionFile(const std::filesystem::path& path, const SubdividedM
         if (!f) return bad(tmp, "cannot write");
         const char zeros[kSubdivisionFileHeaderSize] = {};
         f.write(zeros, sizeof zeros);
-        Writer w(f);
-        w.str(m.source);
+        BinaryWriter w(f);
+        w.str<std::uint32_t>(m.source);
         const SubdivisionParams& p = m.params;
         w.put(static_cast<std::uint8_t>(p.method));
         w.put(p.maxLeafTriangles);
@@ -128,10 +47,10 @@ Status writeSubdivisionFile(const std::filesystem::path& path, const SubdividedM
         w.put(p.planeMove);
         w.put(p.pullUpWidths);
         w.put(p.collapseTo);
-        w.str(m.mesh.name);
-        w.array(m.mesh.positions);
-        w.array(m.mesh.normals);
-        w.array(m.mesh.indices);
+        w.str<std::uint32_t>(m.mesh.name);
+        w.array<std::uint64_t>(m.mesh.positions);
+        w.array<std::uint64_t>(m.mesh.normals);
+        w.array<std::uint64_t>(m.mesh.indices);
         w.put(static_cast<std::uint64_t>(m.subdivision.nodes.size()));
         for (const SubdivisionNode& n : m.subdivision.nodes) {
             w.put(n.box.min);
@@ -194,24 +113,13 @@ Expected<SubdividedModel> readSubdivisionFile(const std::filesystem::path& path)
     if (payload != size - kSubdivisionFileHeaderSize)
         return bad(path, "truncated or padded: header says " + std::to_string(payload) + " payload bytes, file has " +
                              std::to_string(size - kSubdivisionFileHeaderSize));
-    {
-        std::vector<char> chunk(1 << 20);
-        std::uint64_t hash = kFnv1a64Seed, left = payload;
-        while (left > 0) {
-            const auto n = static_cast<std::size_t>(std::min<std::uint64_t>(left, chunk.size()));
-            f.read(chunk.data(), static_cast<std::streamsize>(n));
-            if (!f) return bad(path, "read failed");
-            hash = fnv1a64(chunk.data(), n, hash);
-            left -= n;
-        }
-        if (hash != sum) return bad(path, "checksum mismatch (corrupt)");
-    }
+    if (std::string why = checkPayload(f, payload, sum); !why.empty()) return bad(path, why);
     f.seekg(static_cast<std::streamoff>(kSubdivisionFileHeaderSize));
 
-    Reader r(f, payload);
+    BinaryReader r(f, payload);
     SubdividedModel m;
     m.sourceHash = sourceHash;
-    if (!r.str(m.source, 4096)) return bad(path, "truncated source name");
+    if (!r.str<std::uint32_t>(m.source, 4096)) return bad(path, "truncated source name");
     SubdivisionParams& p = m.params;
     const auto method = r.get<std::uint8_t>();
     if (method > static_cast<std::uint8_t>(SubdivisionMethod::Grid)) return bad(path, "unknown method " + std::to_string(method));
@@ -225,7 +133,7 @@ Expected<SubdividedModel> readSubdivisionFile(const std::filesystem::path& path)
     p.collapseTo = r.get<std::uint32_t>();
     if (r.failed()) return bad(path, "truncated parameters");
     if (Status s = validateSubdivisionParams(p); !s) return bad(path, s.message());
-    if (!r.str(m.mesh.name, 4096) || !r.array(m.mesh.positions) || !r.array(m.mesh.normals) || !r.array(m.mesh.indices))
+    if (!r.str<std::uint32_t>(m.mesh.name, 4096) || !r.array<std::uint64_t>(m.mesh.positions) || !r.array<std::uint64_t>(m.mesh.normals) || !r.array<std::uint64_t>(m.mesh.indices))
         return bad(path, "truncated mesh");
     if (std::string why = validateMesh(m.mesh); !why.empty()) return bad(path, why);
     if (std::string why = validateNormals(m.mesh); !why.empty()) return bad(path, why);

@@ -10,85 +10,13 @@
 #include <string_view>
 #include <vector>
 
+#include "dyncull/objects/binary_file.hpp"
 #include "dyncull/objects/checked_write.hpp"
 
 namespace dyncull {
 namespace {
 
-static_assert(std::endian::native == std::endian::little, "the scene cache is written in host (little-endian) order");
-
 constexpr char kMagic[8] = {'D', 'Y', 'N', 'C', 'S', 'C', 'N', '\0'};
-
-class Writer {
-public:
-    template <class T>
-    void put(const T& v) {
-        static_assert(std::is_trivially_copyable_v<T>);
-        const auto* p = reinterpret_cast<const char*>(&v);
-        buf_.insert(buf_.end(), p, p + sizeof(T));
-    }
-    template <class T>
-    void array(const std::vector<T>& v) {
-        put(static_cast<std::uint32_t>(v.size()));
-        const auto* p = reinterpret_cast<const char*>(v.data());
-        buf_.insert(buf_.end(), p, p + v.size() * sizeof(T));
-    }
-    void str(const std::string& s) {
-        put(static_cast<std::uint32_t>(s.size()));
-        buf_.insert(buf_.end(), s.begin(), s.end());
-    }
-    std::vector<char>& buffer() { return buf_; }
-
-private:
-    std::vector<char> buf_;
-};
-
-/// Bounds-checked cursor: after the first failed read every further read fails too and
-/// returns zeros, so the parser can check once per record.
-class Reader {
-public:
-    Reader(const char* data, std::size_t size) : p_(data), left_(size) {}
-    template <class T>
-    T get() {
-        T v{};
-        if (left_ < sizeof(T)) {
-            fail_ = true;
-            left_ = 0;
-            return v;
-        }
-        std::memcpy(&v, p_, sizeof(T));
-        p_ += sizeof(T);
-        left_ -= sizeof(T);
-        return v;
-    }
-    /// Reads a u32 count then that many T, refusing counts larger than the bytes left
-    /// (so a corrupt count never triggers a huge allocation).
-    template <class T>
-    bool array(std::vector<T>& v) {
-        const std::uint32_t n = get<std::uint32_t>();
-        if (fail_ || n > left_ / sizeof(T)) return fail_ = true, false;
-        v.resize(n);
-        if (n != 0) std::memcpy(v.data(), p_, n * sizeof(T));
-        p_ += n * sizeof(T);
-        left_ -= n * sizeof(T);
-        return true;
-    }
-    bool str(std::string& s) {
-        const std::uint32_t n = get<std::uint32_t>();
-        if (fail_ || n > left_ || n > 4096) return fail_ = true, false;
-        s.assign(p_, n);
-        p_ += n;
-        left_ -= n;
-        return true;
-    }
-    bool failed() const { return fail_; }
-    std::size_t left() const { return left_; }
-
-private:
-    const char* p_;
-    std::size_t left_;
-    bool fail_ = false;
-};
 
 bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
@@ -130,14 +58,19 @@ Error bad(const std::filesystem::path& path, const std::string& why) {
 }  // namespace
 
 Status writeSceneCache(const std::filesystem::path& path, const PreparedScene& scene, std::uint64_t paramsHash) {
-    Writer w;
-    w.buffer().resize(kSceneCacheHeaderSize);
+    std::filesystem::path tmp = path;
+    tmp += ".tmp";
+    std::ofstream f;
+    if (Status s = openChecked(f, tmp); !s) return Error{"scene cache " + s.message()};
+    const char zeros[kSceneCacheHeaderSize] = {};
+    f.write(zeros, sizeof zeros);  // the header, filled in once the payload's size and hash are known
+    BinaryWriter w(f);
     w.put(static_cast<std::uint32_t>(scene.models.size()));
     for (const LocalBsp& b : scene.models) {
-        w.str(b.mesh.name);
-        w.array(b.mesh.positions);
-        w.array(b.mesh.normals);
-        w.array(b.mesh.indices);
+        w.str<std::uint32_t>(b.mesh.name);
+        w.array<std::uint32_t>(b.mesh.positions);
+        w.array<std::uint32_t>(b.mesh.normals);
+        w.array<std::uint32_t>(b.mesh.indices);
         w.put(static_cast<std::uint32_t>(b.nodes.size()));
         for (const LocalBspNode& n : b.nodes) {
             w.put(n.box.min);
@@ -167,22 +100,19 @@ Status writeSceneCache(const std::filesystem::path& path, const PreparedScene& s
         w.put(o.transform.scale);
         w.put(static_cast<std::uint8_t>(o.isStatic ? 1 : 0));
     }
-    std::vector<char>& buf = w.buffer();
-    const std::uint64_t payload = buf.size() - kSceneCacheHeaderSize;
-    const std::uint64_t sum = fnv1a64(buf.data() + kSceneCacheHeaderSize, payload);
+    const std::uint64_t payload = w.size(), sum = w.hash();
     const std::uint32_t version = kSceneCacheVersion, headerSize = kSceneCacheHeaderSize;
-    char* h = buf.data();
+    char h[kSceneCacheHeaderSize] = {};
     std::memcpy(h, kMagic, 8);
     std::memcpy(h + 8, &version, 4);
     std::memcpy(h + 12, &headerSize, 4);
     std::memcpy(h + 16, &paramsHash, 8);
     std::memcpy(h + 24, &payload, 8);
     std::memcpy(h + 32, &sum, 8);
-
-    std::filesystem::path tmp = path;
-    tmp += ".tmp";
-    if (Status s = writeFileChecked(tmp, std::string_view(buf.data(), buf.size())); !s)
-        return Error{"scene cache " + s.message()};
+    f.seekp(0);
+    f.write(h, sizeof h);
+    // The close flushes the last buffer: a full disk may show only here.
+    if (Status s = closeChecked(f, tmp); !s) return Error{"scene cache " + s.message()};
     std::error_code ec;
     std::filesystem::rename(tmp, path, ec);
     if (ec) return Error{"scene cache " + path.string() + ": cannot rename into place: " + ec.message()};
@@ -215,12 +145,9 @@ Expected<PreparedScene> readSceneCache(const std::filesystem::path& path, std::u
     if (payload != size - kSceneCacheHeaderSize)
         return bad(path, "truncated or padded: header says " + std::to_string(payload) + " payload bytes, file has " +
                              std::to_string(size - kSceneCacheHeaderSize));
-    std::vector<char> data(static_cast<std::size_t>(payload));
-    f.read(data.data(), static_cast<std::streamsize>(payload));
-    if (!f) return bad(path, "read failed");
-    if (fnv1a64(data.data(), data.size()) != sum) return bad(path, "checksum mismatch (corrupt)");
-
-    Reader r(data.data(), data.size());
+    if (std::string why = checkPayload(f, payload, sum); !why.empty()) return bad(path, why);
+    f.seekg(static_cast<std::streamoff>(kSceneCacheHeaderSize));
+    BinaryReader r(f, payload);
     PreparedScene scene;
     const std::uint32_t models = r.get<std::uint32_t>();
     // Every model takes well over 16 bytes, so a larger count is corrupt, not a big scene.
@@ -229,7 +156,8 @@ Expected<PreparedScene> readSceneCache(const std::filesystem::path& path, std::u
     for (std::uint32_t i = 0; i < models; ++i) {
         LocalBsp& b = scene.models[i];
         const std::string at = "model " + std::to_string(i) + ": ";
-        if (!r.str(b.mesh.name) || !r.array(b.mesh.positions) || !r.array(b.mesh.normals) || !r.array(b.mesh.indices))
+        if (!r.str<std::uint32_t>(b.mesh.name, 4096) || !r.array<std::uint32_t>(b.mesh.positions) ||
+            !r.array<std::uint32_t>(b.mesh.normals) || !r.array<std::uint32_t>(b.mesh.indices))
             return bad(path, at + "truncated mesh");
         if (std::string why = validateMesh(b.mesh); !why.empty()) return bad(path, at + why);
         if (std::string why = validateNormals(b.mesh); !why.empty()) return bad(path, at + why);

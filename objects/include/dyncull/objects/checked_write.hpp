@@ -1,7 +1,7 @@
 // Writing files with every write and the close checked: a full disk, a read-only mount or
 // /dev/full must come back as an error naming the file, never as a file reported written.
 // The one place for this convention; every dyncull writer of CSV, Markdown, PNG and plot
-// files goes through it (the binary caches write through their own temp-file-and-rename).
+// files goes through it (the binary files stream through BinaryWriter, binary_file.hpp, and check the close here).
 #pragma once
 
 #include <filesystem>
