@@ -114,7 +114,7 @@ int main(int argc, char** argv) {
             (*ctx)->clearFramebuffer(Renderer::kClearColour);
             (*renderer)->beginFrame(cam);
             (*renderer)->drawMesh(*wallId, glm::mat4(1.0f), {0.5f, 0.5f, 0.5f});
-            (*backend)->beginFrame(cam, kWidth, kHeight);
+            (*backend)->beginFrame(FrameView::of(cam, kWidth, kHeight));
             glFinish();
             auto t0 = Clock::now();
             answers.assign(vols.size(), QueryResult::NotReady);

@@ -400,7 +400,7 @@ VolumeBound BenchRunner::volumeBound(VolumeChoice volume) {
     };
     const std::vector<NodeRef>& parts = groundTruth_->lastParts();
     QueryBackend& backend = engine_.queryBackend();
-    backend.beginFrame(engine_.camera(), result_.width, result_.height);
+    backend.beginFrame(FrameView::of(engine_.camera(), result_.width, result_.height));
     VolumeBound b;
     std::vector<QueryId> ids;
     constexpr std::size_t kBatch = 512;  // bounds the query objects in flight

@@ -256,10 +256,12 @@ Expected<FrameStats> Engine::cullAndDraw(View& view, QueryScheduler& scheduler) 
     detail::GlStateScope scope;
     const FrameTarget& target = scope.target();
     backend_->setTarget(target);
-    if (renderer_) renderer_->beginFrame(view.camera);
+    // The frame's view, derived once for the renderer, the scheduler and the query backend.
+    const FrameView frame = FrameView::of(view.camera, target.width(), target.height());
+    if (renderer_) renderer_->beginFrame(frame);
     Sink sink(*this, view.visible);
     TwoLevelTree tree(tree_, objects_);
-    FrameStats st = scheduler.cullFrame(tree, view.camera, target.width(), target.height(), *backend_, sink);
+    FrameStats st = scheduler.cullFrame(tree, frame, *backend_, sink);
     if (renderer_) renderer_->endFrame();
     if (finishEachFrame_) glFinish();
     scope.restore();

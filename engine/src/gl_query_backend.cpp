@@ -93,17 +93,18 @@ GlQueryBackend::~GlQueryBackend() {
     if (program_) glDeleteProgram(program_);
 }
 
-void GlQueryBackend::beginFrame(const Camera& camera, int width, int height) {
+void GlQueryBackend::beginFrame(const FrameView& frame) {
     // Camera-relative like the renderer: volumes are uploaded relative to the eye.
-    viewProj_ = camera.viewProjectionRelative();
+    const Camera& camera = frame.camera;
+    viewProj_ = glm::mat4(frame.viewProjRelative);
     detail::VolumeView& v = *view_;
     v.eye = glm::dvec3(camera.position);
     v.forward = glm::dvec3(camera.forward());
     v.nearPlane = double(camera.nearPlane);
-    v.viewProj = camera.viewProjectionRelativeDouble();
-    v.inverseViewProj = glm::inverse(v.viewProj);
-    v.width = std::max(width, 1);
-    v.height = std::max(height, 1);
+    v.viewProj = frame.viewProjRelative;
+    v.inverseViewProj = frame.inverseViewProjRelative;
+    v.width = frame.width;
+    v.height = frame.height;
     v.ringPixels = params_.snappingRing ? detail::ringWidth(subpixelBits_) : 0.0;
     // Orphan last frame's volumes so writing this frame's never waits on the rasteriser.
     // After a failed allocation both buffers are allocated again (either may have no storage).

@@ -111,7 +111,8 @@ Expected<MeshId> Renderer::upload(const Mesh& mesh, FaceMode faces) {
     return static_cast<MeshId>(meshes_.size() - 1);
 }
 
-void Renderer::beginFrame(const Camera& camera) {
+void Renderer::beginFrame(const FrameView& view) {
+    const Camera& camera = view.camera;
     stats_ = {};
     // Into the framebuffer and viewport the caller bound, over what it holds (no clear).
     detail::useReversedDepth();
@@ -129,7 +130,7 @@ void Renderer::beginFrame(const Camera& camera) {
     // is relative to the eye and stays precise far from the world origin; the eye is then
     // at the origin for lighting.
     camera_ = camera;
-    const glm::mat4 viewProjRel = camera.viewProjectionRelative();
+    const glm::mat4 viewProjRel(view.viewProjRelative);
     // Key light over the viewer's left shoulder, so silhouettes and creases get shading.
     const glm::vec3 f = camera.forward();
     glm::vec3 right = glm::cross(f, camera.up);

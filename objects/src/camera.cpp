@@ -133,6 +133,18 @@ Frustum Frustum::fromCamera(const Camera& camera) {
     return f;
 }
 
+FrameView FrameView::of(const Camera& camera, int width, int height) {
+    FrameView v;
+    v.camera = camera;
+    v.width = std::max(width, 1);
+    v.height = std::max(height, 1);
+    v.viewProjRelative = camera.viewProjectionRelativeDouble();
+    v.inverseViewProjRelative = glm::inverse(v.viewProjRelative);
+    v.frustum = Frustum::fromMatrix(v.viewProjRelative);
+    v.frustum.origin = glm::dvec3(camera.position);
+    return v;
+}
+
 Frustum::Side Frustum::classify(const Aabb& box) const {
     // Double: box corners minus the origin are exact, so a world box 1e7 units from the
     // origin is tested as precisely as one next to it.

@@ -69,8 +69,10 @@ Status validateSchedulerParams(const SchedulerParams& p) {
 
 QueryScheduler::QueryScheduler(SchedulerParams params) : params_(params) {}
 
-FrameStats QueryScheduler::cullFrame(const TwoLevelTree& tree, const Camera& camera, int width, int height,
-                                     QueryBackend& backend, PartSink& sink) {
+FrameStats QueryScheduler::cullFrame(const TwoLevelTree& tree, const FrameView& view, QueryBackend& backend,
+                                     PartSink& sink) {
+    const Camera& camera = view.camera;
+    const int width = view.width, height = view.height;
     const auto t0 = Clock::now();
     FrameStats st;
     ++frame_;  // frame 0 is "never"; the first culled frame is 1
@@ -80,8 +82,8 @@ FrameStats QueryScheduler::cullFrame(const TwoLevelTree& tree, const Camera& cam
     camera_ = camera;
     // Camera-relative (eye at the origin, set up in double): precise at any distance from
     // the world origin, like the renderer's and the query backend's transforms.
-    viewProj_ = camera.viewProjectionRelativeDouble();
-    frustum_ = Frustum::fromCamera(camera);
+    viewProj_ = view.viewProjRelative;
+    frustum_ = view.frustum;
     width_ = width;
     height_ = height;
     stats_ = &st;
@@ -104,7 +106,7 @@ FrameStats QueryScheduler::cullFrame(const TwoLevelTree& tree, const Camera& cam
         lastPlacement_.resize(slots, 0);
     }
 
-    backend.beginFrame(camera, width, height);
+    backend.beginFrame(view);
     const Aabb rootBox = tree.worldBox(tree.root());
     if (!rootBox.empty()) active_.push_back(tree.root());
     frontBudget_ = frontLeavesSeen_ = 0;

@@ -69,7 +69,7 @@ TEST(BatchedRasterTest, AnswersEveryVolumeAsOneHardwareQueryEach) {
             m = glm::scale(glm::rotate(m, pos(rng), glm::vec3(1, 0, 0)), glm::vec3(s(rng)));
             r.drawMesh(k % 2 ? sphere : quad, m, {0.5f, 0.5f, 0.5f});
         }
-        b.beginFrame(cam, 160, 120);
+        b.beginFrame(FrameView::of(cam, 160, 120));
         const std::vector<QueryVolume> volumes = randomVolumes(rng, 300);
         std::vector<QueryId> oracle;
         b.beginBatch();
@@ -107,7 +107,7 @@ TEST(BatchedRasterTest, NearPlaneVolumesAreVisibleUndrawnAndStateIsRestored) {
     ctx->clearFramebuffer(Renderer::kClearColour);
     r.beginFrame(cam);
     r.drawMesh(wall, glm::mat4(1.0f), {0.5f, 0.5f, 0.5f});
-    b.beginFrame(cam, test::kW, test::kH);
+    b.beginFrame(FrameView::of(cam, test::kW, test::kH));
 
     // A game's state, which the test must leave as it was.
     GLuint ssbo = 0;
@@ -253,7 +253,7 @@ TEST(VolumeSnapping, TheRingKeepsEveryPixelOfAPartInsideItsVolume) {
                 }
                 glDisable(GL_SCISSOR_TEST);
                 glClearDepth(0.0);
-                b.beginFrame(cam, kSize, kSize);
+                b.beginFrame(FrameView::of(cam, kSize, kSize));
                 b.beginBatch();
                 const QueryId q = b.issue(volume);
                 b.endBatch();

@@ -29,7 +29,7 @@ TEST(OcclusionQuery, HiddenBoxZeroVisibleBoxOne) {
     r.drawMesh(wall, glm::mat4(1.0f), {0.5f, 0.5f, 0.5f});
     const glm::u8vec4 before = r.readPixels().at(32, 32);
 
-    b.beginFrame(cam, test::kW, test::kH);
+    b.beginFrame(FrameView::of(cam, test::kW, test::kH));
     b.beginBatch();
     const QueryId behind = b.issue(QueryVolume::fromAabb(Aabb::fromMinMax({-0.5f, -0.5f, -2.0f}, {0.5f, 0.5f, -1.0f})));
     const QueryId inFront = b.issue(QueryVolume::fromAabb(Aabb::fromMinMax({-0.5f, -0.5f, 1.0f}, {0.5f, 0.5f, 2.0f})));
@@ -85,7 +85,7 @@ TEST(OcclusionQuery, BackendMeshVolumesAndVolumesReachingTheNearPlane) {
     ctx->clearFramebuffer(Renderer::kClearColour);
     r.beginFrame(cam);
     r.drawMesh(wall, glm::mat4(1.0f), {0.5f, 0.5f, 0.5f});
-    b.beginFrame(cam, test::kW, test::kH);
+    b.beginFrame(FrameView::of(cam, test::kW, test::kH));
     b.beginBatch();
     const QueryId behind = b.issue(octahedron({0, 0, -1.0f}, glm::vec3(0.5f)));
     const QueryId inFront = b.issue(octahedron({0, 0, 1.0f}, glm::vec3(0.5f)));
@@ -119,7 +119,7 @@ TEST(OcclusionQuery, VolumesCoverTheSameSamplesWhateverTheirWinding) {
     ctx->clearFramebuffer(Renderer::kClearColour);
     r.beginFrame(cam);
     r.drawMesh(wall, glm::mat4(1.0f), {0.5f, 0.5f, 0.5f});
-    b.beginFrame(cam, test::kW, test::kH);
+    b.beginFrame(FrameView::of(cam, test::kW, test::kH));
     const QueryVolume mixed = octahedron({0.2f, -0.1f, 0.0f}, {0.6f, 0.4f, 0.5f});
     QueryVolume outward = mixed, inward = mixed;
     for (std::uint32_t t = 0; t < mixed.triangleCount; ++t) {
@@ -168,7 +168,7 @@ TEST(OcclusionQuery, ReleasedQueryObjectWaitsForALaterAnswerBeforeReuse) {
         b.release(q);
         return q;
     };
-    b.beginFrame(cam, test::kW, test::kH);
+    b.beginFrame(FrameView::of(cam, test::kW, test::kH));
     const QueryId first = stopAndWait();
     EXPECT_EQ(b.poolSize(), 1u);
     // `first` was released, but no query begun since has answered: a second object.

@@ -93,7 +93,7 @@ struct ScriptedBackend final : QueryBackend {
     bool inBatch = false;
     std::vector<std::vector<QueryVolume>> batches;
 
-    void beginFrame(const Camera&, int, int) override {}
+    void beginFrame(const FrameView&) override {}
     void beginBatch() override { EXPECT_FALSE(inBatch); inBatch = true; batches.emplace_back(); }
     QueryId issue(const QueryVolume& v) override {
         EXPECT_TRUE(inBatch);
@@ -569,7 +569,7 @@ struct DrawQueryBackend final : QueryBackend {
     bool inDraw = false;
     std::uint32_t lastDrawn = ~0u;  // written by the sink
 
-    void beginFrame(const Camera&, int, int) override { boxes.clear(); }
+    void beginFrame(const FrameView&) override { boxes.clear(); }
     void beginBatch() override { EXPECT_FALSE(inDraw); }
     QueryId issue(const QueryVolume& v) override {
         boxes.push_back(v);
@@ -704,7 +704,7 @@ namespace {
 struct HungBackend final : QueryBackend {
     int issued = 0, released = 0, polls = 0, waits = 0;
     std::vector<double> waitBounds;
-    void beginFrame(const Camera&, int, int) override {}
+    void beginFrame(const FrameView&) override {}
     void beginBatch() override {}
     QueryId issue(const QueryVolume&) override { return static_cast<QueryId>(issued++); }
     void endBatch() override {}
@@ -891,7 +891,7 @@ struct DepthBackend final : QueryBackend {
     int reads = 0, tested = 0;
     std::vector<std::vector<QueryResult>> answers;  // per batch, until collected
 
-    void beginFrame(const Camera&, int, int) override {}
+    void beginFrame(const FrameView&) override {}
     void beginBatch() override { ADD_FAILURE() << "two-phase issues no hardware query"; }
     QueryId issue(const QueryVolume&) override { return 0; }
     void endBatch() override {}

@@ -46,7 +46,7 @@ public:
     static Expected<std::unique_ptr<GlQueryBackend>> create(GlContext& context, GlQueryParams params = {});
     ~GlQueryBackend() override;
 
-    void beginFrame(const Camera& camera, int width, int height) override;
+    void beginFrame(const FrameView& view) override;
     void beginBatch() override;
     QueryId issue(const QueryVolume& volume) override;
     void endBatch() override;

@@ -69,7 +69,8 @@ public:
     /// GL_GREATER; objects/camera.hpp), depth and colour writes on, view/projection from
     /// `camera` (world space; its aspect is used as given: set it to the viewport's).
     /// Changes GL state without restoring it: the Engine calls it inside its state scope.
-    void beginFrame(const Camera& camera);
+    void beginFrame(const FrameView& view);
+    void beginFrame(const Camera& camera) { beginFrame(FrameView::of(camera, 1, 1)); }
     /// Draws indices [firstIndex, firstIndex + indexCount) of mesh `id` with object-to-world
     /// matrix `model`, in linear-ish RGB `colour` (0..1). Culls back faces if the mesh was
     /// uploaded with FaceMode::CullBack (a mirroring `model` is accounted for).

@@ -96,4 +96,19 @@ struct Frustum {
     bool outside(const Aabb& box) const { return classify(box) == Side::Outside; }
 };
 
+/// One frame's view, derived once from the camera and the viewport and handed to every
+/// stage (scheduler, query backend, renderer), so none derives its own: the camera (world
+/// space), the viewport in pixels, the camera-relative view-projection in double
+/// (Camera::viewProjectionRelativeDouble) and its inverse, and the frustum (fromCamera).
+struct FrameView {
+    Camera camera;
+    int width = 1, height = 1;
+    glm::dmat4 viewProjRelative{1.0};
+    glm::dmat4 inverseViewProjRelative{1.0};
+    Frustum frustum;
+
+    /// `width` and `height` are clamped to at least 1.
+    static FrameView of(const Camera& camera, int width, int height);
+};
+
 }  // namespace dyncull

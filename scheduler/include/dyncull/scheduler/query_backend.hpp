@@ -74,9 +74,9 @@ class QueryBackend {
 public:
     virtual ~QueryBackend() = default;
 
-    /// Start of a frame: the camera whose view-projection query volumes are drawn with
-    /// (world space) and the viewport in pixels.
-    virtual void beginFrame(const Camera& camera, int width, int height) = 0;
+    /// Start of a frame: the view whose camera-relative view-projection query volumes are
+    /// drawn with, and the viewport in pixels (FrameView, derived once per frame).
+    virtual void beginFrame(const FrameView& view) = 0;
     /// Brackets a group of queries issued together, so state (colour/depth masks,
     /// the volume shader) is switched once per batch rather than once per query.
     virtual void beginBatch() = 0;

@@ -182,8 +182,12 @@ public:
     /// Traverses `tree` front-to-back for `camera` (world space), drawing visible parts
     /// through `sink` and querying through `backend`. Returns the frame's counts and CPU
     /// times (frameMs and updateMs are left for the caller, who owns glFinish and the tree update).
-    FrameStats cullFrame(const TwoLevelTree& tree, const Camera& camera, int width, int height,
-                         QueryBackend& backend, PartSink& sink);
+    FrameStats cullFrame(const TwoLevelTree& tree, const FrameView& view, QueryBackend& backend, PartSink& sink);
+    /// The same for a camera and viewport whose FrameView is made here.
+    FrameStats cullFrame(const TwoLevelTree& tree, const Camera& camera, int width, int height, QueryBackend& backend,
+                         PartSink& sink) {
+        return cullFrame(tree, FrameView::of(camera, width, height), backend, sink);
+    }
 
     /// Forget all history (e.g. after a camera cut).
     void resetHistory() { history_.clear(); }
