@@ -119,8 +119,8 @@ public:
         // glGetGraphicsResetStatus instead of as undefined behaviour: EGL 1.5 core
         // attribute, else EGL_EXT_create_context_robustness (which ties it to robust
         // access); a driver that refuses gets a plain context (GlContext::resetNotification()
-        // says which). EGL 1.5 lets us skip robust buffer access: it cost 1% of a bunny
-        // frame on llvmpipe, and dyncull never indexes past its buffers.
+        // says which). EGL 1.5 lets us skip robust buffer access, which costs frame time
+        // (docs/RELIABILITY.md) and which dyncull, never indexing past its buffers, needs not.
         std::vector<EGLint> robust = attribs;
         if (major > 1 || (major == 1 && minor >= 5)) {
             robust.insert(robust.end(), {EGL_CONTEXT_OPENGL_RESET_NOTIFICATION_STRATEGY, EGL_LOSE_CONTEXT_ON_RESET});

@@ -542,8 +542,8 @@ void QueryScheduler::runQueries() {
     const bool keepOrder = params_.useWaitOrder && !params_.batchOverlapping;
     // Occupancy-map fast accept: a rectangle touching screen area where nothing has been
     // drawn cannot be hidden. Tested as soon as a node is reached, even if a nearer waiting
-    // node overlaps it: deferring the test too was measured slower (three times the
-    // waiting for 3% fewer parts drawn, 800-triangle bunny parts).
+    // node overlaps it: deferring the test too waited far longer for few parts saved
+    // (docs/BENCHMARKS.md, "Waiting order").
     auto occupancyAccept = [&](NodeRef ref, const Aabb& box, const ScreenRect& rect) -> bool {
         if (!params_.useOccupancyAccept || drawnMap_.allSet(rect)) return false;
         ++stats_->skippedByOccupancy;

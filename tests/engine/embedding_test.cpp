@@ -376,62 +376,66 @@ TEST(Embedding, WithoutThePartRendererTheGameDrawsThePartsItIsTold) {
     EXPECT_EQ(ctx->checkErrors(), 0u);
 }
 
-// Two views of one scene side by side (split screen): each has its own camera, history and
-// visible lists, and draws in its half exactly what it draws alone.
-TEST(Embedding, TwoViewsOfOneSceneDrawSideBySide) {
+// Two views of one scene and a second engine side by side, in three viewports of one
+// framebuffer: each view has its own camera, history and visible lists, and each
+// viewport holds exactly what its view draws alone.
+TEST(Embedding, TwoViewsAndTwoEnginesDrawSideBySide) {
     auto ctx = test::headless();
     ASSERT_TRUE(ctx);
-    GameScene scene(*ctx);
-    ASSERT_TRUE(scene.engine);
+    GameScene scene(*ctx), other(*ctx);
+    ASSERT_TRUE(scene.engine && other.engine);
     Engine& engine = *scene.engine;
+    constexpr int kThird = kGameW / 3;
     SchedulerParams queries;  // hardware queries: a box wholly behind the wall is culled at once
     queries.mode = CullMode::Queries;
     ASSERT_TRUE(engine.setSchedulerParams(queries).ok());
-    Camera behind = test::cameraOnZ(-3.0f);  // from the other side of the wall
-    behind.aspect = float(kGameW / 2) / float(kGameH);
+    Camera front = test::cameraOnZ(3.0f), behind = test::cameraOnZ(-3.0f);  // either side of the wall
+    front.aspect = behind.aspect = float(kThird) / float(kGameH);
+    ASSERT_TRUE(engine.setCamera(front).ok());
     auto second = engine.addView(behind, queries);
     ASSERT_TRUE(second.ok()) << second.error().message;
     const ViewId back = *second;
     SchedulerParams invalid = queries;
     invalid.maxQueriesInFlight = 0;
     EXPECT_FALSE(engine.addView(behind, invalid).ok());
+    Camera aside = front;  // the second engine's scene from higher up
+    aside.position = {1.0f, 2.0f, 3.0f};
+    ASSERT_TRUE(other.engine->setCamera(aside).ok());
 
-    GameFramebuffer fb;
-    auto drawAlone = [&](ViewId view, bool left) {
-        fb.clear();
-        glBindFramebuffer(GL_FRAMEBUFFER, fb.fbo);
-        glViewport(left ? 0 : kGameW / 2, 0, kGameW / 2, kGameH);
-        EXPECT_TRUE(engine.renderView(view).ok());
-        std::vector<glm::u8vec4> rgba;
-        std::vector<float> depth;
-        fb.read(rgba, depth);
-        return rgba;
+    struct Slot {
+        Engine* engine;
+        ViewId view;
     };
-    for (int warm = 0; warm < 3; ++warm) {  // histories settle
-        (void)drawAlone(kMainView, true);
-        (void)drawAlone(back, false);
-    }
-    const auto mainAlone = drawAlone(kMainView, true), backAlone = drawAlone(back, false);
-
-    fb.clear();
-    glBindFramebuffer(GL_FRAMEBUFFER, fb.fbo);
-    glViewport(0, 0, kGameW / 2, kGameH);
-    ASSERT_TRUE(engine.renderFrame().ok());
-    glViewport(kGameW / 2, 0, kGameW / 2, kGameH);
-    ASSERT_TRUE(engine.renderView(back).ok());
-    std::vector<glm::u8vec4> both;
+    const Slot slots[3] = {{&engine, kMainView}, {&engine, back}, {other.engine.get(), kMainView}};
+    GameFramebuffer fb;
+    auto draw = [&](int slot) {
+        glBindFramebuffer(GL_FRAMEBUFFER, fb.fbo);
+        glViewport(slot * kThird, 0, kThird, kGameH);
+        EXPECT_TRUE(slots[slot].engine->renderView(slots[slot].view).ok());
+    };
+    std::vector<glm::u8vec4> alone[3], all;
     std::vector<float> depth;
-    fb.read(both, depth);
-    std::uint64_t leftDiffers = 0, rightDiffers = 0;
-    for (int y = 0; y < kGameH; ++y)
-        for (int x = 0; x < kGameW / 2; ++x) {
-            const std::size_t l = std::size_t(y) * kGameW + x, r = l + kGameW / 2;
-            leftDiffers += both[l] != mainAlone[l];
-            rightDiffers += both[r] != backAlone[r];
+    for (int pass = 0; pass < 4; ++pass)  // histories settle; the last pass is the reference
+        for (int slot = 0; slot < 3; ++slot) {
+            fb.clear();
+            draw(slot);
+            fb.read(alone[slot], depth);
         }
-    EXPECT_EQ(leftDiffers, 0u);
-    EXPECT_EQ(rightDiffers, 0u);
-    // Each view sees its own side of the wall.
+    fb.clear();
+    for (int slot = 0; slot < 3; ++slot) draw(slot);
+    fb.read(all, depth);
+    for (int slot = 0; slot < 3; ++slot) {
+        std::uint64_t differ = 0, drawn = 0;
+        for (int y = 0; y < kGameH; ++y)
+            for (int x = slot * kThird; x < (slot + 1) * kThird; ++x) {
+                const std::size_t i = std::size_t(y) * kGameW + x;
+                differ += all[i] != alone[slot][i];
+                drawn += all[i] != kGameColour;
+            }
+        EXPECT_EQ(differ, 0u) << "viewport " << slot;
+        EXPECT_GT(drawn, 100u) << "viewport " << slot;
+    }
+    // Each view of the first engine sees its own side of the wall.
     EXPECT_TRUE(engine.isVisible(scene.front, kMainView));
     EXPECT_FALSE(engine.isVisible(scene.hidden, kMainView));
     EXPECT_TRUE(engine.isVisible(scene.hidden, back));
