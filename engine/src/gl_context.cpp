@@ -160,16 +160,24 @@ Status GlContext::checkReset() {
     return Error{lostMessage_, ErrorCode::ContextLost};
 }
 
-Status GlContext::checkAllocation(const std::string& what, std::size_t bytes) {
-    bool outOfMemory = false;
-    for (int guard = 0; guard < 64; ++guard) {  // as in checkErrors: bounded on a lost context
+GlContext::DrainedErrors GlContext::drainErrors(Tally tally) {
+    DrainedErrors d;
+    for (int guard = 0; guard < 64; ++guard) {
         const GLenum e = glGetError();
         if (e == GL_NO_ERROR) break;
-        if (e == GL_OUT_OF_MEMORY) outOfMemory = true;  // still a GL error: counted like any other
-        if (debug_) continue;
+        if (d.count++ == 0) d.first = e;
+        if (e == GL_OUT_OF_MEMORY) d.outOfMemory = true;
+        if (tally == Tally::None || debug_) continue;  // a debug context's callback counted it when it happened
         ++errorCount_;
-        if (errorCount_ <= 20) std::fprintf(stderr, "GL error 0x%04x\n", static_cast<unsigned>(e));
+        if (tally == Tally::CountAndReport && errorCount_ <= 20)
+            std::fprintf(stderr, "GL error 0x%04x\n", static_cast<unsigned>(e));
     }
+    return d;
+}
+
+Status GlContext::checkAllocation(const std::string& what, std::size_t bytes) {
+    // GL_OUT_OF_MEMORY is still a GL error: counted like any other.
+    bool outOfMemory = drainErrors(Tally::CountAndReport).outOfMemory;
     if (faults_.allocationsBeforeFailure > 0) {
         --faults_.allocationsBeforeFailure;
     } else if (faults_.failBufferAllocations > 0) {
@@ -196,24 +204,12 @@ const char* glErrorName(GLenum e) {
 }
 }  // namespace
 
-std::uint32_t GlContext::takeCallerErrors() {
-    std::uint32_t n = 0;
-    for (int guard = 0; guard < 64; ++guard) {  // bounded: glGetError may never clear on a lost context
-        if (glGetError() == GL_NO_ERROR) break;
-        ++n;
-    }
-    return n;
-}
+std::uint32_t GlContext::takeCallerErrors() { return drainErrors(Tally::None).count; }
 
 Status GlContext::checkErrorsDuring(const char* what) {
-    GLenum first = GL_NO_ERROR;
-    std::uint32_t n = 0;
-    for (int guard = 0; guard < 64; ++guard) {
-        const GLenum e = glGetError();
-        if (e == GL_NO_ERROR) break;
-        if (n++ == 0) first = e;
-        if (!debug_) ++errorCount_;  // a debug context's callback counted it already
-    }
+    const DrainedErrors d = drainErrors(Tally::Count);
+    const std::uint32_t n = d.count;
+    const GLenum first = d.first;
     if (n == 0) return {};
     char code[16];
     std::snprintf(code, sizeof code, "0x%04x", static_cast<unsigned>(first));
@@ -223,13 +219,7 @@ Status GlContext::checkErrorsDuring(const char* what) {
 }
 
 std::uint64_t GlContext::checkErrors() {
-    for (int guard = 0; guard < 64; ++guard) {  // glGetError may never clear on a lost context
-        const GLenum e = glGetError();
-        if (e == GL_NO_ERROR) break;
-        if (debug_) continue;  // the debug callback already counted it when it happened
-        ++errorCount_;
-        if (errorCount_ <= 20) std::fprintf(stderr, "GL error 0x%04x\n", static_cast<unsigned>(e));
-    }
+    drainErrors(Tally::CountAndReport);
     return errorCount_;
 }
 

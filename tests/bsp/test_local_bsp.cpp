@@ -175,6 +175,7 @@ TEST_P(BothMethods, AttributesCarriedThroughTheSplitMatchTheSplitPositions) {
     }
     // Bad sizes and missing provenance are errors, not crashes.
     EXPECT_FALSE(carryAttributes(bsp, xyzw, 0).ok());
+    EXPECT_FALSE(carryAttributes(bsp, xyzw, 0xFFFFFFFFu).ok());  // vertices x 2^32 - 1 components: sizes checked, not overflowed
     EXPECT_FALSE(carryAttributes(bsp, std::span<const float>(xyzw).first(xyzw.size() - 1), 4).ok());
     LocalBsp handMade = bsp;
     handMade.splitVertices.clear();

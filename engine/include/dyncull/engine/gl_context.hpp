@@ -140,6 +140,23 @@ protected:
     /// Deletes the fingerprint (subclass destructors, with the context current).
     void releaseCommon();
 
+private:
+    /// What draining the GL error flags found: how many, the first, and whether one was
+    /// GL_OUT_OF_MEMORY.
+    struct DrainedErrors {
+        std::uint32_t count = 0;
+        std::uint32_t first = 0;  // GLenum; 0 = GL_NO_ERROR
+        bool outOfMemory = false;
+    };
+    enum class Tally : std::uint8_t {
+        None,            ///< the caller's errors: not added to glErrorCount()
+        Count,           ///< added (unless the debug callback counted them already)
+        CountAndReport,  ///< added, and the first 20 printed to stderr
+    };
+    /// The one loop over glGetError, bounded because the flags may never clear on a lost context.
+    DrainedErrors drainErrors(Tally tally);
+
+protected:
     ContextKind kind_;
     std::uint32_t framebuffer_ = 0;
     glm::ivec2 size_{0};
