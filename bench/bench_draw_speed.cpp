@@ -7,6 +7,8 @@
 // parts: shading per vertex or per pixel, culled back faces, triangle order in the parts.
 // `*-discard` variants run the same frame with GL_RASTERIZER_DISCARD: vertex work and
 // per-draw overhead only, so total minus discard is the rasterisation and fragment cost.
+// `parts*` and `test-*` draw or test every part in view through the part renderer, to
+// weigh the two-phase mode's draw marks and triangle tests against drawing.
 //
 // Usage: bench_draw_speed [--frames N] [--count 300] [--box 8] [--bunny-size 1]
 //        [--orbit 12] [--speed 0.02] [--size 640x360] [--out DIR] [--mesh FILE]
@@ -138,6 +140,92 @@ private:
     std::vector<std::pair<float, std::uint32_t>> order_;  // (distance, object slot)
 };
 
+[[noreturn]] void fail(const std::string& message) {
+    std::fprintf(stderr, "bench_draw_speed: %s\n", message.c_str());
+    std::exit(1);
+}
+
+// The parts of every bunny in view, nearest bunny first, each part drawn or tested alone
+// through the part renderer: what the two-phase mode's triangle tests cost beside drawing
+// the same parts. Marked draws and tests store into a storage buffer at the marks' binding
+// point, read back at the end (the answers in hand).
+class PartLoop {
+public:
+    enum class Kind { Draw, DrawMarked, TestVisible, TestHidden };
+    PartLoop() { glCreateBuffers(1, &marks_); }
+    ~PartLoop() { glDeleteBuffers(1, &marks_); }
+
+    std::uint64_t run(Engine& engine, Kind kind) {
+        Renderer& r = engine.renderer();
+        engine.context().clearFramebuffer(Renderer::kClearColour);
+        // A test against a cleared depth buffer: every fragment passes (visible). Against depth
+        // 1, the nearest value in reversed Z: every fragment fails (hidden behind a wall).
+        if (kind == Kind::TestHidden) {
+            glClearDepth(1.0);
+            glClear(GL_DEPTH_BUFFER_BIT);
+            glClearDepth(0.0);
+        }
+        const Camera& camera = engine.camera();
+        r.beginFrame(FrameView::of(camera, engine.context().size().x, engine.context().size().y));
+        const bool test = kind == Kind::TestVisible || kind == Kind::TestHidden;
+        if (test) {
+            glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+            glDepthMask(GL_FALSE);
+        }
+        const SceneObjects& objs = engine.objects();
+        const Frustum frustum = Frustum::fromCamera(camera);
+        order_.clear();
+        for (std::uint32_t o = 0; o < objs.slotCount(); ++o) {
+            if (!objs.alive(o) || frustum.outside(objs.worldBox(o))) continue;
+            order_.push_back({glm::length(objs.worldBox(o).center() - camera.position), o});
+        }
+        std::stable_sort(order_.begin(), order_.end());
+        std::uint32_t slots = 0;
+        for (const auto& [distance, o] : order_)
+            for (const LocalBspNode& n : objs.model(objs.modelOf(o)).nodes) slots += n.isLeaf() ? 1u : 0u;
+        if (kind != Kind::Draw) {
+            glNamedBufferData(marks_, std::max<GLsizeiptr>(4, GLsizeiptr{4} * slots), nullptr, GL_STREAM_READ);
+            const std::uint32_t zero = 0;
+            glClearNamedBufferData(marks_, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, detail::kMarksBinding, marks_);
+        }
+        std::uint64_t triangles = 0;
+        std::uint32_t slot = 0;
+        for (const auto& [distance, o] : order_) {
+            const MeshId mesh = engine.meshOf(objs.modelOf(o));
+            for (const LocalBspNode& n : objs.model(objs.modelOf(o)).nodes) {
+                if (!n.isLeaf()) continue;
+                if (test)
+                    r.testRange(mesh, n.firstIndex, n.indexCount, objs.matrix(o), slot);
+                else
+                    r.drawRange(mesh, n.firstIndex, n.indexCount, objs.matrix(o), colourForId(o),
+                                kind == Kind::DrawMarked ? slot : Renderer::kNoMark);
+                ++slot;
+                triangles += n.indexCount / 3;
+            }
+        }
+        r.endFrame();
+        if (test) {
+            glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+            glDepthMask(GL_TRUE);
+        }
+        if (kind != Kind::Draw) {
+            answers_.resize(slots);
+            glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+            glGetNamedBufferSubData(marks_, 0, GLsizeiptr{4} * slots, answers_.data());
+            const auto visible = static_cast<std::uint32_t>(std::count(answers_.begin(), answers_.end(), 1u));
+            if ((kind == Kind::TestHidden && visible != 0) || (kind == Kind::TestVisible && visible == 0))
+                fail("triangle test answered " + std::to_string(visible) + " of " + std::to_string(slots) + " parts visible");
+        }
+        return triangles;
+    }
+
+private:
+    GLuint marks_ = 0;
+    std::vector<std::pair<float, std::uint32_t>> order_;
+    std::vector<std::uint32_t> answers_;
+};
+
 struct Variant {
     std::string name;
     std::string what;
@@ -151,11 +239,6 @@ double median(std::vector<double> v) {
     std::sort(v.begin(), v.end());
     const std::size_t n = v.size();
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-[[noreturn]] void fail(const std::string& message) {
-    std::fprintf(stderr, "bench_draw_speed: %s\n", message.c_str());
-    std::exit(1);
 }
 
 struct Swarm {
@@ -285,6 +368,15 @@ int main(int argc, char** argv) {
                             vfcFrame(*forced, Shading::Vertex, true, false), {}, 0, {}});
     variants.push_back({"vfc-load-order", "vfc with the parts' triangles in load order",
                         vfcFrame(unordered, Shading::Vertex, true, false), {}, 0, {}});
+    PartLoop parts;
+    auto partFrame = [&](PartLoop::Kind kind) { return finished([&parts, &tuned, kind] { return parts.run(*tuned.engine, kind); }); };
+    variants.push_back({"parts", "every part in view drawn alone, nearest bunny first, no traversal", partFrame(PartLoop::Kind::Draw), {}, 0, {}});
+    variants.push_back({"parts-marked", "parts, each draw marking whether it showed a sample (two-phase's draw marks)",
+                        partFrame(PartLoop::Kind::DrawMarked), {}, 0, {}});
+    variants.push_back({"test-visible", "every part tested on its own triangles, every fragment passing",
+                        partFrame(PartLoop::Kind::TestVisible), {}, 0, {}});
+    variants.push_back({"test-hidden", "every part tested on its own triangles behind a wall (every fragment fails)",
+                        partFrame(PartLoop::Kind::TestHidden), {}, 0, {}});
     variants.push_back({"vfc-before", "the renderer before issue 21: per-pixel, two-sided, load order",
                         vfcFrame(unordered, Shading::Pixel, false, false), {}, 0, {}});
 
@@ -313,7 +405,7 @@ int main(int argc, char** argv) {
             const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
             if (f < 0) continue;
             v.ms.push_back(ms);
-            if (f == 0 && v.name.find("discard") == std::string::npos) v.first = tuned.engine->renderer().readPixels();
+            if (f == 0 && v.name.find("discard") == std::string::npos && v.name.rfind("test", 0) != 0) v.first = tuned.engine->renderer().readPixels();
         }
         if (f >= 0) std::fprintf(stderr, "\rframe %lld/%u", static_cast<long long>(f + 1), frames);
     }

@@ -49,9 +49,17 @@ ModeSpec queriesMode(const std::string& name) {
 
 /// `full` and its ablations (two-phase), or false.
 bool applyTwoPhaseName(const std::string& part, ModeSpec& m) {
-    if (part != "full" && part != "full-hzb" && part != "full-nohist" && part != "full-nocost") return false;
+    if (part != "full" && part != "full-hzb" && part != "full-nohist" && part != "full-nocost" && part != "full-tri")
+        return false;
     m.scheduler.mode = CullMode::TwoPhase;
     m.scheduler.useBatchedRaster = part != "full-hzb";
+    if (part == "full-tri") {
+        // Every part whose volume passed is tested on its triangles: the design measured,
+        // not the cost model's choice (which on llvmpipe tests almost none).
+        m.scheduler.useTriangleTests = true;
+        m.scheduler.costs.triangleTestNsPerPart = 0.0;
+        m.scheduler.costs.triangleTestNsPerTriangle = 0.0;
+    }
     m.scheduler.useHistory = part != "full-nohist";
     m.scheduler.useCostModel = part != "full-nocost";
     return true;
@@ -62,7 +70,7 @@ bool applyTwoPhaseName(const std::string& part, ModeSpec& m) {
 std::string modeNamesHelp() {
     return "vfc, simple, full (two-phase: draw last frame's visible parts, test the rest against their depth pyramid, then what it cannot reject in one batched raster test where that pays), "
            "queries (hardware occlusion queries with history, batching and occupancy maps; the default before two-phase), oracle; "
-           "ablations of full: full-hzb (the pyramid alone), full-nohist (every part drawn early tested again each frame), full-nocost (every volume the pyramid lets through tested); "
+           "ablations of full: full-hzb (the pyramid alone), full-tri (every part whose volume passes then tested on its own triangles, and draws marked), full-nohist (every part drawn early tested again each frame), full-nocost (every volume the pyramid lets through tested); "
            "settings of queries: approximate thrN (pixel threshold), latency1 (last frame's results), "
            "skipN (history max skip N, 2 per visible), overlap (overlapping batches), smallN (small-feature pixels); "
            "backend: noflush (no glFlush after each batch); "

@@ -7,14 +7,16 @@
 #include <epoxy/gl.h>
 
 #include "gl_state_scope.hpp"
+#include "part_marks.hpp"
 
 namespace dyncull {
 
 // Records every part in the view's visible lists, then draws it (the game's callback or
-// the part renderer).
+// the part renderer). With the part renderer it also tests parts on their own triangles.
 struct Engine::Sink final : PartSink {
     Engine& e;
     VisibleLists& visible;
+    bool marking = false;
     Sink(Engine& engine, VisibleLists& lists) : e(engine), visible(lists) {}
     void drawPart(NodeRef part, std::uint32_t firstIndex, std::uint32_t indexCount) override {
         const SceneObjects& objs = e.objects_;
@@ -25,13 +27,48 @@ struct Engine::Sink final : PartSink {
             visible.stamp[object] = visible.serial;
             visible.objects.push_back(handle);
         }
-        const ModelId model = objs.modelOf(object);
         if (e.callback_) {
-            e.callback_(handle, model, firstIndex, indexCount, objs.matrix(object));
+            e.callback_(handle, objs.modelOf(object), firstIndex, indexCount, objs.matrix(object));
             return;
         }
+        render({part, firstIndex, indexCount}, marking ? e.marks_->nextDrawSlot() : Renderer::kNoMark);
+    }
+    void render(const PartRange& p, std::uint32_t markSlot) {
+        const SceneObjects& objs = e.objects_;
+        const std::uint32_t object = p.part.object;
         const glm::vec3 colour = object < e.hasColour_.size() && e.hasColour_[object] ? e.colour_[object] : colourForId(object);
-        e.renderer_->drawRange(e.meshOfModel_[model], firstIndex, indexCount, objs.matrix(object), colour);
+        e.renderer_->drawRange(e.meshOfModel_[objs.modelOf(object)], p.firstIndex, p.indexCount, objs.matrix(object),
+                               colour, markSlot);
+    }
+    bool testsTriangles() const override { return !e.callback_ && e.renderer_ && e.marks_; }
+    void beginDrawMarks() override {
+        assert(testsTriangles());
+        e.marks_->beginDraws();
+        marking = true;
+    }
+    void readDrawMarks(std::span<QueryResult> out) override {
+        assert(marking && out.size() == e.marks_->drawCount());
+        e.marks_->readDraws(out);
+    }
+    void testParts(std::span<const PartRange> parts, std::span<QueryResult> out) override {
+        assert(testsTriangles() && out.size() == parts.size());
+        if (!e.marks_->beginTest(static_cast<std::uint32_t>(parts.size()))) {
+            std::fill(out.begin(), out.end(), QueryResult::Visible);  // no buffer: test nothing
+            return;
+        }
+        // Writes off: the test draws nothing into the image.
+        glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+        glDepthMask(GL_FALSE);
+        const SceneObjects& objs = e.objects_;
+        for (std::uint32_t i = 0; i < parts.size(); ++i) {
+            const std::uint32_t object = parts[i].part.object;
+            e.renderer_->testRange(e.meshOfModel_[objs.modelOf(object)], parts[i].firstIndex, parts[i].indexCount,
+                                   objs.matrix(object), i);
+        }
+        glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+        glDepthMask(GL_TRUE);
+        e.marks_->endTest();
+        e.marks_->readTest(out);
     }
 };
 
@@ -40,6 +77,8 @@ Engine::Engine(GlContext& context, const EngineOptions& options)
     View& main = views_.emplace_back();
     main.scheduler = std::make_unique<QueryScheduler>(options.scheduler);
 }
+
+Engine::~Engine() = default;
 
 void Engine::VisibleLists::begin(std::uint32_t slots) {
     if (++serial == 0) {  // wrapped after 2^32 frames: no slot may look drawn this frame
@@ -131,6 +170,7 @@ Expected<std::unique_ptr<Engine>> Engine::create(GlContext& context, const Engin
         auto renderer = Renderer::create(context);
         if (!renderer) return renderer.error();
         e->renderer_ = renderer.take();
+        e->marks_ = std::make_unique<detail::PartMarks>(context);
     }
     auto backend = GlQueryBackend::create(context, options.queries);
     if (!backend) return backend.error();

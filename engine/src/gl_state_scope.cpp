@@ -4,6 +4,7 @@
 #include <iterator>
 
 #include "depth_convention.hpp"
+#include "shader_program.hpp"
 
 namespace dyncull::detail {
 namespace {
@@ -34,6 +35,9 @@ GlStateScope::GlStateScope() {
     glGetIntegerv(GL_VERTEX_ARRAY_BINDING, &vao_);
     glGetIntegerv(GL_ARRAY_BUFFER_BINDING, &arrayBuffer_);
     glGetIntegerv(GL_SHADER_STORAGE_BUFFER_BINDING, &ssbo_);
+    glGetIntegeri_v(GL_SHADER_STORAGE_BUFFER_BINDING, kMarksBinding, &marksSsbo_);
+    glGetInteger64i_v(GL_SHADER_STORAGE_BUFFER_START, kMarksBinding, &marksStart_);
+    glGetInteger64i_v(GL_SHADER_STORAGE_BUFFER_SIZE, kMarksBinding, &marksSize_);
     glGetIntegerv(GL_PIXEL_PACK_BUFFER_BINDING, &pixelPackBuffer_);
     glGetIntegerv(GL_PACK_ALIGNMENT, &packAlignment_);
     glGetIntegerv(GL_PACK_ROW_LENGTH, &packRowLength_);
@@ -83,7 +87,11 @@ void GlStateScope::restore() {
     glUseProgram(static_cast<GLuint>(program_));
     glBindVertexArray(static_cast<GLuint>(vao_));
     glBindBuffer(GL_ARRAY_BUFFER, static_cast<GLuint>(arrayBuffer_));
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, static_cast<GLuint>(ssbo_));
+    if (marksSize_ > 0)
+        glBindBufferRange(GL_SHADER_STORAGE_BUFFER, kMarksBinding, static_cast<GLuint>(marksSsbo_), marksStart_, marksSize_);
+    else
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kMarksBinding, static_cast<GLuint>(marksSsbo_));
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, static_cast<GLuint>(ssbo_));  // the generic binding, after the indexed one
     glBindBuffer(GL_PIXEL_PACK_BUFFER, static_cast<GLuint>(pixelPackBuffer_));
     glPixelStorei(GL_PACK_ALIGNMENT, packAlignment_);
     glPixelStorei(GL_PACK_ROW_LENGTH, packRowLength_);

@@ -30,6 +30,8 @@ private:
     bool restored_ = false;
     GLint drawFbo_ = 0, readFbo_ = 0, viewport_[4] = {0, 0, 0, 0};
     GLint program_ = 0, vao_ = 0, arrayBuffer_ = 0, ssbo_ = 0, pixelPackBuffer_ = 0;
+    GLint marksSsbo_ = 0;  // the indexed binding the part renderer's marks use (kMarksBinding)
+    GLint64 marksStart_ = 0, marksSize_ = 0;
     GLint packAlignment_ = 4, packRowLength_ = 0, packSkipRows_ = 0, packSkipPixels_ = 0;
     GLint depthFunc_ = GL_LESS, cullMode_ = GL_BACK, frontFace_ = GL_CCW, polygonMode_ = GL_FILL;
     GLint clipOrigin_ = GL_LOWER_LEFT, clipDepth_ = GL_NEGATIVE_ONE_TO_ONE;

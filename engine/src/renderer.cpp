@@ -22,17 +22,29 @@ Expected<std::unique_ptr<Renderer>> Renderer::create(GlContext& context) {
                                        {detail::kLitVertexShader, detail::kLitFragmentShader}};
     static_assert(static_cast<int>(Shading::Vertex) == 0 && static_cast<int>(Shading::Pixel) == 1);
     for (int i = 0; i < 2; ++i) {
-        std::string log;
-        LitProgram& p = r->programs_[i];
-        p.id = detail::buildProgram(sources[i][0], sources[i][1], log);
-        if (!p.id) return Error{"renderer: lit shader rejected by " + context.rendererName() + ": " + log};
-        p.viewProj = glGetUniformLocation(p.id, "uViewProj");
-        p.model = glGetUniformLocation(p.id, "uModel");
-        p.normalMat = glGetUniformLocation(p.id, "uNormalMat");
-        p.colour = glGetUniformLocation(p.id, "uColour");
-        p.eye = glGetUniformLocation(p.id, "uEye");  // -1 in the per-vertex program (the eye is the origin)
-        p.light = glGetUniformLocation(p.id, "uLightDir");
+        for (int marking = 0; marking < 2; ++marking) {
+            std::string log;
+            LitProgram& p = r->programs_[i][marking];
+            const std::string fragment = detail::litFragmentSource(sources[i][1], marking == 1);
+            p.id = detail::buildProgram(sources[i][0], fragment.c_str(), log);
+            if (!p.id) return Error{"renderer: lit shader rejected by " + context.rendererName() + ": " + log};
+            p.viewProj = glGetUniformLocation(p.id, "uViewProj");
+            p.model = glGetUniformLocation(p.id, "uModel");
+            p.normalMat = glGetUniformLocation(p.id, "uNormalMat");
+            p.colour = glGetUniformLocation(p.id, "uColour");
+            p.eye = glGetUniformLocation(p.id, "uEye");  // -1 in the per-vertex program (the eye is the origin)
+            p.light = glGetUniformLocation(p.id, "uLightDir");
+            p.markSlot = glGetUniformLocation(p.id, "uMarkSlot");  // -1 in the plain variant
+        }
     }
+    std::string log;
+    const std::string testFragment = detail::litFragmentSource(detail::kTriangleTestFragmentShader, true);
+    TestProgram& t = r->testProgram_;
+    t.id = detail::buildProgram(detail::kTriangleTestVertexShader, testFragment.c_str(), log);
+    if (!t.id) return Error{"renderer: triangle-test shader rejected by " + context.rendererName() + ": " + log};
+    t.viewProj = glGetUniformLocation(t.id, "uViewProj");
+    t.model = glGetUniformLocation(t.id, "uModel");
+    t.markSlot = glGetUniformLocation(t.id, "uMarkSlot");
     return r;
 }
 
@@ -43,8 +55,10 @@ Renderer::~Renderer() {
         glDeleteBuffers(1, &m.vbo);
         glDeleteBuffers(1, &m.ibo);
     }
-    for (const LitProgram& p : programs_)
-        if (p.id) glDeleteProgram(p.id);
+    for (const auto& variants : programs_)
+        for (const LitProgram& p : variants)
+            if (p.id) glDeleteProgram(p.id);
+    if (testProgram_.id) glDeleteProgram(testProgram_.id);
 }
 
 void Renderer::release(MeshId id) {
@@ -138,16 +152,20 @@ void Renderer::beginFrame(const FrameView& view) {
     const glm::vec3 up = glm::cross(right, f);
     const glm::vec3 light = glm::normalize(-f + 0.9f * up - 0.6f * right);
 
-    const LitProgram& p = programs_[static_cast<int>(shading_)];
-    glUseProgram(p.id);
-    glUniformMatrix4fv(p.viewProj, 1, GL_FALSE, glm::value_ptr(viewProjRel));
+    // Both variants get the frame's uniforms: a frame may mix marked and plain draws.
     const glm::vec3 eyeRelative(0.0f);
-    if (p.eye >= 0) glUniform3fv(p.eye, 1, glm::value_ptr(eyeRelative));
-    glUniform3fv(p.light, 1, glm::value_ptr(light));
+    for (const LitProgram& p : programs_[static_cast<int>(shading_)]) {
+        glUseProgram(p.id);
+        glUniformMatrix4fv(p.viewProj, 1, GL_FALSE, glm::value_ptr(viewProjRel));
+        if (p.eye >= 0) glUniform3fv(p.eye, 1, glm::value_ptr(eyeRelative));
+        glUniform3fv(p.light, 1, glm::value_ptr(light));
+    }
+    glUseProgram(testProgram_.id);
+    glUniformMatrix4fv(testProgram_.viewProj, 1, GL_FALSE, glm::value_ptr(viewProjRel));
 }
 
 void Renderer::drawRange(MeshId id, std::uint32_t firstIndex, std::uint32_t count, const glm::mat4& model,
-                         const glm::vec3& colour) {
+                         const glm::vec3& colour, std::uint32_t markSlot) {
     assert(id < meshes_.size());
     const GpuMesh& g = meshes_[id];
     assert(firstIndex <= g.indexCount && count <= g.indexCount - firstIndex);
@@ -157,8 +175,9 @@ void Renderer::drawRange(MeshId id, std::uint32_t firstIndex, std::uint32_t coun
     const glm::mat3 linear(model);
     const glm::mat3 normalMat = glm::inverseTranspose(linear);
     detail::setFaceCulling(cullEnabled_, frontCcw_, g.cullBack && cullBackFaces_, linear);
-    const LitProgram& p = programs_[static_cast<int>(shading_)];
+    const LitProgram& p = programs_[static_cast<int>(shading_)][markSlot != kNoMark];
     glUseProgram(p.id);
+    if (markSlot != kNoMark) glUniform1ui(p.markSlot, markSlot);
     const glm::mat4 relative = camera_.relativeModel(model);
     glUniformMatrix4fv(p.model, 1, GL_FALSE, glm::value_ptr(relative));
     glUniformMatrix3fv(p.normalMat, 1, GL_FALSE, glm::value_ptr(normalMat));
@@ -170,6 +189,22 @@ void Renderer::drawRange(MeshId id, std::uint32_t firstIndex, std::uint32_t coun
                    reinterpret_cast<const void*>(static_cast<std::uintptr_t>(firstIndex) * sizeof(std::uint32_t)));
     ++stats_.drawCalls;
     stats_.triangles += count / 3;
+}
+
+void Renderer::testRange(MeshId id, std::uint32_t firstIndex, std::uint32_t count, const glm::mat4& model,
+                         std::uint32_t markSlot) {
+    assert(id < meshes_.size() && markSlot != kNoMark);
+    const GpuMesh& g = meshes_[id];
+    assert(firstIndex <= g.indexCount && count <= g.indexCount - firstIndex);
+    if (count == 0) return;
+    detail::setFaceCulling(cullEnabled_, frontCcw_, g.cullBack && cullBackFaces_, glm::mat3(model));
+    glUseProgram(testProgram_.id);
+    glUniform1ui(testProgram_.markSlot, markSlot);
+    const glm::mat4 relative = camera_.relativeModel(model);
+    glUniformMatrix4fv(testProgram_.model, 1, GL_FALSE, glm::value_ptr(relative));
+    glBindVertexArray(g.vao);
+    glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(count), GL_UNSIGNED_INT,
+                   reinterpret_cast<const void*>(static_cast<std::uintptr_t>(firstIndex) * sizeof(std::uint32_t)));
 }
 
 void Renderer::endFrame() {

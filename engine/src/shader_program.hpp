@@ -10,11 +10,21 @@ namespace dyncull::detail {
 std::uint32_t buildProgram(const char* vertexSource, const char* fragmentSource, std::string& log);
 
 /// GLSL sources of the mesh shaders (lit per vertex, lit per pixel) and of the
-/// position-only box shader.
+/// position-only box shader. The lit fragment shaders hold two placeholders,
+/// DYNCULL_MARKS_DECLARATION and DYNCULL_MARK, that litFragmentSource() fills.
 extern const char* const kVertexLitVertexShader;
 extern const char* const kVertexLitFragmentShader;
 extern const char* const kLitVertexShader;
 extern const char* const kLitFragmentShader;
+extern const char* const kTriangleTestVertexShader;
+extern const char* const kTriangleTestFragmentShader;  // a lit fragment shader's placeholders, marking only
+extern const char* const kMarksDeclaration;
+extern const char* const kMarkStatement;
+/// `source` (a lit fragment shader) with its placeholders replaced by kMarksDeclaration and
+/// kMarkStatement (`marking`), or removed.
+std::string litFragmentSource(const char* source, bool marking);
+/// Storage-buffer binding point of the marks (kMarksDeclaration).
+inline constexpr std::uint32_t kMarksBinding = 1;
 extern const char* const kBoxVertexShader;
 extern const char* const kBoxFragmentShader;
 

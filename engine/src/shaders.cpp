@@ -6,6 +6,8 @@
 // dense scene shades each pixel several times, while its triangles are a few pixels big.
 #include "shader_program.hpp"
 
+#include <string_view>
+
 namespace dyncull::detail {
 
 // Per-vertex lighting (Shading::Vertex). The light is white, so only its intensity varies
@@ -21,6 +23,7 @@ uniform mat4 uModel;
 uniform mat3 uNormalMat;
 uniform vec3 uLightDir;  // towards the light, unit, world space
 out float vIntensity;
+invariant gl_Position;  // as kTriangleTestVertexShader's, so a test sees the drawn fragments
 void main() {
     vec4 world = uModel * vec4(aPosition, 1.0);  // relative to the eye (camera-relative)
     gl_Position = uViewProj * world;
@@ -34,10 +37,14 @@ void main() {
 )";
 
 const char* const kVertexLitFragmentShader = R"(#version 450 core
+DYNCULL_MARKS_DECLARATION
 in float vIntensity;
 uniform vec3 uColour;  // already raised to 1 / 1.2
 out vec4 fragColour;
-void main() { fragColour = vec4(min(uColour * vIntensity, vec3(1.0)), 1.0); }
+void main() {
+    fragColour = vec4(min(uColour * vIntensity, vec3(1.0)), 1.0);
+    DYNCULL_MARK;
+}
 )";
 
 // Per-pixel lighting (Shading::Pixel): the same terms evaluated per fragment.
@@ -49,6 +56,7 @@ uniform mat4 uModel;
 uniform mat3 uNormalMat;
 out vec3 vWorldPos;
 out vec3 vNormal;
+invariant gl_Position;  // as kTriangleTestVertexShader's, so a test sees the drawn fragments
 void main() {
     vec4 world = uModel * vec4(aPosition, 1.0);
     vWorldPos = world.xyz;
@@ -58,6 +66,7 @@ void main() {
 )";
 
 const char* const kLitFragmentShader = R"(#version 450 core
+DYNCULL_MARKS_DECLARATION
 in vec3 vWorldPos;
 in vec3 vNormal;
 uniform vec3 uColour;
@@ -73,7 +82,49 @@ void main() {
     float fill = pow(max(dot(n, v), 0.0), 2.0);
     vec3 c = uColour * (0.18 + 0.12 * hemi + 0.55 * key + 0.22 * fill);
     fragColour = vec4(pow(clamp(c, 0.0, 1.0), vec3(1.0 / 1.2)), 1.0);
+    DYNCULL_MARK;
 }
+)";
+
+// Marks (renderer.hpp, Renderer::drawRange's `markSlot`): the variant of a lit fragment
+// shader that also records whether its part drew a sample that passed the depth test. With
+// early depth testing only passing fragments run, so a store means a visible sample; the
+// shaders neither discard nor write depth, so testing early changes no pixel. The plain
+// variant leaves both placeholders out.
+const char* const kMarksDeclaration = R"(
+layout(early_fragment_tests) in;
+layout(std430, binding = 1) writeonly buffer Marks { uint marks[]; };
+uniform uint uMarkSlot;
+)";
+const char* const kMarkStatement = "marks[uMarkSlot] = 1u";
+
+std::string litFragmentSource(const char* source, bool marking) {
+    std::string s(source);
+    auto fill = [&s](std::string_view placeholder, std::string_view text) {
+        const std::size_t at = s.find(placeholder);
+        if (at != std::string::npos) s.replace(at, placeholder.size(), text);
+    };
+    fill("DYNCULL_MARKS_DECLARATION", marking ? kMarksDeclaration : "");  // first: DYNCULL_MARK is its prefix
+    fill("DYNCULL_MARK", marking ? kMarkStatement : "");
+    return s;
+}
+
+// The triangle test (Renderer::testRange): the lit shaders' position, computed by the same
+// expression and declared invariant in all three, so a test rasterises exactly the
+// fragments a draw would; and only the mark in the fragment stage.
+const char* const kTriangleTestVertexShader = R"(#version 450 core
+layout(location = 0) in vec3 aPosition;
+uniform mat4 uViewProj;
+uniform mat4 uModel;
+invariant gl_Position;
+void main() {
+    vec4 world = uModel * vec4(aPosition, 1.0);
+    gl_Position = uViewProj * world;
+}
+)";
+const char* const kTriangleTestFragmentShader = R"(#version 450 core
+DYNCULL_MARKS_DECLARATION
+void main() { DYNCULL_MARK; }
 )";
 
 const char* const kBoxVertexShader = R"(#version 450 core

@@ -61,7 +61,8 @@ Status validateSchedulerParams(const SchedulerParams& p) {
     if (!(p.frontPercent >= 0.0f && p.frontPercent <= 100.0f)) return Error{"frontPercent must be in [0, 100]"};
     if (!(p.autoVolumeSaving >= 0.0f && p.autoVolumeSaving <= 1.0f)) return Error{"autoVolumeSaving must be in [0, 1]"};
     if (static_cast<int>(p.volume) > static_cast<int>(VolumeChoice::Auto)) return Error{"volume has an unknown value"};
-    for (double c : {p.costs.drawNsPerTriangle, p.costs.testNsPerVolume, p.costs.testNsPerPixel, p.costs.depthReadNs})
+    for (double c : {p.costs.drawNsPerTriangle, p.costs.testNsPerVolume, p.costs.testNsPerPixel, p.costs.depthReadNs,
+                     p.costs.triangleTestNsPerPart, p.costs.triangleTestNsPerTriangle})
         if (!(c >= 0.0 && c < 1e12)) return Error{"costs must be finite and non-negative (nanoseconds)"};
     if (p.costs.probeFrames == 0) return Error{"costs.probeFrames must be at least 1"};
     return {};
@@ -79,6 +80,7 @@ FrameStats QueryScheduler::cullFrame(const TwoLevelTree& tree, const FrameView& 
     tree_ = &tree;
     backend_ = &backend;
     sink_ = &sink;
+    marking_ = false;
     camera_ = camera;
     // Camera-relative (eye at the origin, set up in double): precise at any distance from
     // the world origin, like the renderer's and the query backend's transforms.
@@ -304,6 +306,7 @@ void QueryScheduler::drawNode(NodeRef ref, bool untested) {
         }
     } else {
         sink_->drawPart(ref, n.firstIndex, n.indexCount);
+        if (marking_) markedDraws_.push_back(ref);  // the sink marks its draws in this order
     }
     stats_->drawMs += msSince(t0);
     ++stats_->partsDrawn;

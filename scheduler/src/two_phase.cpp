@@ -9,6 +9,11 @@
 //     raster test against the early depth (NVIDIA's gl_occlusion_culling "temporal current
 //     frame" scheme) and the visible ones drawn; then the parts drawn are tested against
 //     the final depth, and those visible there are next frame's early set.
+// Where the sink draws the parts itself, step 4 goes one level finer: the parts whose
+// volumes passed are tested on their own triangles before they are drawn, and each draw
+// marks whether it showed a sample, so the early set is the parts whose triangles, not
+// volumes, were visible (the test on the geometry that the volume bound in
+// docs/BENCHMARKS.md called for; no paper of ours has it).
 // Which volumes are tested is the question of NOHC (Guthe et al. 2006: a query's cost
 // against drawing's) and CHC++ (Mattausch et al. 2008: visible nodes only every few
 // frames; both in ../shared/notes/batched-occlusion-tests.md): a cost model weighs a
@@ -60,6 +65,12 @@ bool QueryScheduler::projectVolumeDepth(const QueryVolume& volume, ScreenRect& r
 void QueryScheduler::runTwoPhase() {
     const SceneObjects& objs = tree_->objects();
     const NodeRef root = active_.empty() ? NodeRef{} : active_.back();
+    const bool triangles = params_.useTriangleTests && sink_->testsTriangles();
+    markedDraws_.clear();
+    if (triangles) {
+        sink_->beginDrawMarks();
+        marking_ = true;
+    }
 
     // 1. Early pass. lastTouchedFrame marks a part drawn in it.
     const std::uint32_t partsBefore = stats_->partsDrawn;
@@ -104,6 +115,7 @@ void QueryScheduler::runTwoPhase() {
     // parts drawn early are collected in `refresh_` to be tested against the final depth.
     candidates_.clear();
     refresh_.clear();
+    triangleTests_.clear();
     const bool raster = params_.useBatchedRaster && testing;
     if (!(root == NodeRef{})) active_.push_back(root);
     while (!active_.empty()) {
@@ -159,7 +171,7 @@ void QueryScheduler::runTwoPhase() {
             tree_->expand(ref, camera_.position, scratch_);
             for (auto it = scratch_.rbegin(); it != scratch_.rend(); ++it) active_.push_back(*it);
         } else if (drawnEarly) {
-            if (!raster || certain) continue;
+            if (!raster || certain || triangles) continue;  // marks answer for it with triangles
             // Visibility history, as in Queries: a part that kept answering "visible" is
             // tested again only after the frames its answers earn. The cost model may
             // postpone it further, but not past history's longest postponement, so every
@@ -201,13 +213,18 @@ void QueryScheduler::runTwoPhase() {
                 culledTriangles_ += subtreeTriangles(ref);
                 history_.recordAnswer(h, false, frame_);
                 trace(ref, tree_->worldBox(ref), NodeState::Occluded);
+            } else if (triangles && (worthTriangleTest(ref) || exploring(ref))) {
+                const LocalBspNode& n = objs.model(objs.modelOf(ref.object)).nodes[ref.node];
+                triangleTests_.push_back({ref, n.firstIndex, n.indexCount});
             } else {
                 trace(ref, tree_->worldBox(ref), NodeState::VisibleQueried);
                 drawNode(ref, false);
-                refresh_.push_back(candidates_[i]);  // may be hidden by parts drawn after it
+                if (!triangles) refresh_.push_back(candidates_[i]);  // may be hidden by parts drawn after it
             }
         }
     }
+    if (!triangleTests_.empty()) testTriangles();
+    if (triangles) readDrawMarks();
     if (!refresh_.empty()) {
         rasterTest(refresh_);
         learn(refreshOccludedRate_, rasterAnswers_);
@@ -220,10 +237,61 @@ void QueryScheduler::runTwoPhase() {
     // A frame with no early depth (the first, or after everything turned hidden) had
     // nothing to test the pyramid against, so only the final-depth tests measured what
     // testing saves; without them the frame says nothing and the estimate stands.
-    if (testing && (drewEarly || !refresh_.empty())) {
+    if (testing && (drewEarly || !refresh_.empty() || triangles)) {
         lastTestedFrame_ = frame_;
         savedNs_ = double(culledTriangles_) * params_.costs.drawNsPerTriangle;
     }
+}
+
+void QueryScheduler::testTriangles() {
+    const SceneObjects& objs = tree_->objects();
+    const auto t0 = Clock::now();
+    triangleAnswers_.assign(triangleTests_.size(), QueryResult::Visible);
+    sink_->testParts(triangleTests_, triangleAnswers_);
+    stats_->triangleTests += static_cast<std::uint32_t>(triangleTests_.size());
+    stats_->triangleTestMs += msSince(t0);
+    const auto occluded = std::count(triangleAnswers_.begin(), triangleAnswers_.end(), QueryResult::Occluded);
+    triangleOccludedRate_ += 0.25 * (double(occluded) / double(triangleTests_.size()) - triangleOccludedRate_);
+    for (std::size_t i = 0; i < triangleTests_.size(); ++i) {
+        const NodeRef ref = triangleTests_[i].part;
+        if (triangleAnswers_[i] == QueryResult::Occluded) {
+            ++stats_->queriesOccluded;
+            culledTriangles_ += triangleTests_[i].indexCount / 3;
+            history_.recordAnswer(history_.at(ref, objs), false, frame_);
+            trace(ref, tree_->worldBox(ref), NodeState::Occluded);
+        } else {
+            trace(ref, tree_->worldBox(ref), NodeState::VisibleQueried);
+            drawNode(ref, false);  // its draw mark says whether it stays visible
+        }
+    }
+}
+
+void QueryScheduler::readDrawMarks() {
+    const SceneObjects& objs = tree_->objects();
+    const auto t0 = Clock::now();
+    triangleAnswers_.assign(markedDraws_.size(), QueryResult::Visible);
+    if (!markedDraws_.empty()) sink_->readDrawMarks(triangleAnswers_);
+    stats_->triangleTestMs += msSince(t0);
+    // A draw that showed nothing was hidden by what was drawn before it, and stays hidden
+    // (depth only grows nearer): not drawn early next frame. One that showed a sample may
+    // have been covered later; it is drawn early and marked again.
+    for (std::size_t i = 0; i < markedDraws_.size(); ++i) {
+        const NodeRef ref = markedDraws_[i];
+        const bool visible = triangleAnswers_[i] != QueryResult::Occluded;
+        if (!visible) {
+            ++stats_->drawMarksHidden;
+            culledTriangles_ += subtreeTriangles(ref);
+        }
+        history_.recordAnswer(history_.at(ref, objs), visible, frame_);
+    }
+    marking_ = false;
+}
+
+bool QueryScheduler::worthTriangleTest(NodeRef ref) {
+    if (!params_.useCostModel) return true;
+    const SchedulerParams::TestCosts& c = params_.costs;
+    const double triangles = double(subtreeTriangles(ref));
+    return triangleOccludedRate_ * triangles * c.drawNsPerTriangle > c.triangleTestNsPerPart + triangles * c.triangleTestNsPerTriangle;
 }
 
 bool QueryScheduler::worthTesting(NodeRef ref, const ScreenRect& rect, double occludedRate) {

@@ -25,6 +25,8 @@ TEST(BenchModes, AblationsOfFullAndTheirVolumes) {
     EXPECT_FALSE(modeFromName("full-hzb")->scheduler.useBatchedRaster);
     EXPECT_FALSE(modeFromName("full-nohist")->scheduler.useHistory);
     EXPECT_FALSE(modeFromName("full-nocost")->scheduler.useCostModel);
+    EXPECT_FALSE(modeFromName("full")->scheduler.useTriangleTests);
+    EXPECT_TRUE(modeFromName("full-tri")->scheduler.useTriangleTests);
     const ModeSpec k = modeFromName("full+kdop26").take();
     EXPECT_EQ(k.scheduler.mode, CullMode::TwoPhase);
     EXPECT_EQ(k.scheduler.volume, VolumeChoice::Kdop26);

@@ -113,9 +113,11 @@ std::map<std::string, std::vector<double>> snapshot() {
     enabled("cull face", GL_CULL_FACE);
     enabled("polygon offset fill", GL_POLYGON_OFFSET_FILL);
     enabled("rasteriser discard", GL_RASTERIZER_DISCARD);
-    GLint ssbo0 = 0;
-    glGetIntegeri_v(GL_SHADER_STORAGE_BUFFER_BINDING, 0, &ssbo0);
-    s["storage buffer binding 0"] = {double(ssbo0)};
+    for (GLuint binding : {0u, 1u}) {  // the batched raster test's and the part marks'
+        GLint buffer = 0;
+        glGetIntegeri_v(GL_SHADER_STORAGE_BUFFER_BINDING, binding, &buffer);
+        s["storage buffer binding " + std::to_string(binding)] = {double(buffer)};
+    }
     return s;
 }
 
@@ -158,7 +160,8 @@ struct GameState {
         glBindVertexArray(vao);
         glBindBuffer(GL_ARRAY_BUFFER, buffer);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, storage);
-        glBindBuffer(GL_SHADER_STORAGE_BUFFER, buffer);  // the generic binding differs from binding 0
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, storage);
+        glBindBuffer(GL_SHADER_STORAGE_BUFFER, buffer);  // the generic binding differs from bindings 0 and 1
         glBindBuffer(GL_PIXEL_PACK_BUFFER, buffer);
         glPixelStorei(GL_PACK_ALIGNMENT, 1);
         glPixelStorei(GL_PACK_ROW_LENGTH, 7);
@@ -212,19 +215,24 @@ TEST(Embedding, GameStateAndFramebufferAreUntouchedByAFrame) {
     SchedulerParams alwaysTest;  // two-phase testing every frame (the cost model would pause)
     alwaysTest.useCostModel = false;
     QueryScheduler testingScheduler(alwaysTest);
+    SchedulerParams triangles = alwaysTest;  // and on the parts' own triangles, draws marked
+    triangles.useTriangleTests = true;
+    QueryScheduler triangleScheduler(triangles);
 
     // Frames of the default mode, of two-phase with its depth readback and batched raster
-    // test every frame, and of hardware queries, each against the game's state and framebuffer.
+    // test every frame (then with triangle tests too), and of hardware queries, each against
+    // the game's state and framebuffer.
     std::vector<glm::u8vec4> firstFrame;  // every mode must draw the same image (conservative, static scene)
-    for (int frame = 0; frame < 9; ++frame) {
+    for (int frame = 0; frame < 12; ++frame) {
         GameState::reset();
         fb.clear();
         std::vector<glm::u8vec4> rgba;
         std::vector<float> depth;
         GameState game(fb, ctx->framebuffer());
         const auto before = snapshot();
-        auto st = frame % 3 == 0   ? engine.renderFrame()
-                  : frame % 3 == 1 ? engine.renderFrame(testingScheduler)
+        auto st = frame % 4 == 0   ? engine.renderFrame()
+                  : frame % 4 == 1 ? engine.renderFrame(testingScheduler)
+                  : frame % 4 == 2 ? engine.renderFrame(triangleScheduler)
                                    : engine.renderFrame(queryScheduler);
         ASSERT_TRUE(st.ok()) << st.error().message;
         const auto after = snapshot();

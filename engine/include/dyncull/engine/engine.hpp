@@ -77,6 +77,10 @@ inline constexpr ViewId kMainView = 0;
 /// destructor then deletes no GL object: they die with their own context). Calls that do
 /// not touch GL (objects, transforms, camera, parameters) need no context. Two Engines on
 /// two contexts may run on two threads.
+namespace detail {
+class PartMarks;
+}
+
 class Engine {
 public:
     /// Errors: invalid scheduler parameters, the context not current (WrongContext) or
@@ -170,10 +174,19 @@ public:
         return *renderer_;
     }
     bool hasRenderer() const { return renderer_ != nullptr; }
+    /// The part renderer's mesh of `model` (its split mesh, uploaded by addModel).
+    MeshId meshOf(ModelId model) const {
+        assert(renderer_ && model < meshOfModel_.size());
+        return meshOfModel_[model];
+    }
     GlContext& context() { return context_; }
     /// The view's scheduler (the main view's for an unknown view).
     QueryScheduler& scheduler(ViewId view = kMainView);
     GlQueryBackend& queryBackend() { return *backend_; }
+
+    ~Engine();
+    Engine(const Engine&) = delete;
+    Engine& operator=(const Engine&) = delete;
 
 private:
     Engine(GlContext& context, const EngineOptions& options);
@@ -207,6 +220,7 @@ private:
     GlContext& context_;
     std::unique_ptr<Renderer> renderer_;
     std::unique_ptr<GlQueryBackend> backend_;
+    std::unique_ptr<detail::PartMarks> marks_;  // with the part renderer: tests on the parts' own triangles
     SceneObjects objects_;
     LooseBsp tree_;
     bool treeBuilt_ = false;

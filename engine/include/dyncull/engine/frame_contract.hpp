@@ -14,8 +14,9 @@
 // During the call the Engine sets, for its own draws and tests only: clip control
 // (GL_LOWER_LEFT, GL_ZERO_TO_ONE), depth range [0, 1], depth test with GL_GREATER, depth
 // and colour writes, face culling per mesh, polygon mode fill, and blending, stencil test,
-// depth clamp and rasteriser discard off; its own programs, vertex arrays and buffers; the
-// pixel-pack state of its depth readback.
+// depth clamp and rasteriser discard off; its own programs, vertex arrays and buffers
+// (storage-buffer binding points 0 and 1 included); the pixel-pack state of its depth
+// readback.
 // Out: every one of those is as the caller left it, and so are the framebuffer bindings,
 // the viewport and the framebuffer's pixels outside what dyncull's renderer drew (nothing
 // is cleared). It calls glFinish only if asked (Engine::setFinishEachFrame).

@@ -74,8 +74,20 @@ public:
     /// Draws indices [firstIndex, firstIndex + indexCount) of mesh `id` with object-to-world
     /// matrix `model`, in linear-ish RGB `colour` (0..1). Culls back faces if the mesh was
     /// uploaded with FaceMode::CullBack (a mirroring `model` is accounted for).
+    /// With a `markSlot`, every fragment that passes the depth test also stores 1 at that
+    /// index of the uint storage buffer bound at binding point 1 (detail::kMarksBinding),
+    /// which the caller owns, binds and reads (engine/src/part_marks.hpp): whether the
+    /// draw showed a sample. With colour and depth writes off the same draw is an exact
+    /// occlusion test of the range's own triangles. The image is the same either way.
     void drawRange(MeshId id, std::uint32_t firstIndex, std::uint32_t indexCount, const glm::mat4& model,
-                   const glm::vec3& colour);
+                   const glm::vec3& colour, std::uint32_t markSlot = kNoMark);
+    /// The exact occlusion test of a range's own triangles: drawRange's fragments (the same
+    /// positions, by an invariant expression, and the same face culling), depth-tested
+    /// with the current depth function, mark `markSlot` as drawRange's marks do. Only the
+    /// fragment's mark is computed: the caller turns colour and depth writes off (else the
+    /// test would draw). Not counted in stats().
+    void testRange(MeshId id, std::uint32_t firstIndex, std::uint32_t indexCount, const glm::mat4& model,
+                   std::uint32_t markSlot);
     void drawMesh(MeshId id, const glm::mat4& model, const glm::vec3& colour) {
         drawRange(id, 0, indexCount(id), model, colour);
     }
@@ -105,6 +117,8 @@ public:
 
     /// Clear colour (dark grey-blue).
     static constexpr glm::vec3 kClearColour{0.11f, 0.12f, 0.15f};
+    /// drawRange without a mark.
+    static constexpr std::uint32_t kNoMark = 0xffffffffu;
 
 private:
     explicit Renderer(GlContext& context) : context_(context) {}
@@ -117,12 +131,16 @@ private:
     };
     struct LitProgram {
         std::uint32_t id = 0;
-        int viewProj = -1, model = -1, normalMat = -1, colour = -1, eye = -1, light = -1;
+        int viewProj = -1, model = -1, normalMat = -1, colour = -1, eye = -1, light = -1, markSlot = -1;
     };
     GlContext& context_;
     std::vector<GpuMesh> meshes_;
     std::size_t uploadedBytes_ = 0;
-    LitProgram programs_[2];  // indexed by Shading
+    LitProgram programs_[2][2];  // by Shading, then plain (0) or marking (1)
+    struct TestProgram {
+        std::uint32_t id = 0;
+        int viewProj = -1, model = -1, markSlot = -1;
+    } testProgram_;
     Shading shading_ = Shading::Vertex;
     bool cullBackFaces_ = true;
     bool discard_ = false;

@@ -18,6 +18,9 @@ struct FrameStats {
     std::uint32_t rasterTests = 0;    ///< two-phase: volumes in batched raster tests (QueryBackend::testVolumes)
     std::uint32_t rasterBatches = 0;  ///< two-phase: batched raster tests issued
     double rasterMs = 0.0;            ///< two-phase: building, drawing and waiting for the batched raster tests
+    std::uint32_t triangleTests = 0;  ///< two-phase: parts tested on their own triangles (PartSink::testParts)
+    double triangleTestMs = 0.0;      ///< two-phase: drawing and waiting for the triangle tests, and reading the draw marks
+    std::uint32_t drawMarksHidden = 0;  ///< two-phase: parts drawn whose draw showed no sample
     std::uint64_t queryTriangles = 0;   ///< triangles of the query volumes drawn (12 per box)
     std::uint32_t queriesOccluded = 0;  ///< answered "occluded"
     std::uint32_t queriesTimedOut = 0;  ///< never answered within the bound; counted visible

@@ -3,6 +3,7 @@
 // GL_SAMPLES_PASSED with a threshold); tests provide scripted and software backends.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <span>
@@ -131,14 +132,41 @@ public:
     }
 };
 
-/// What the scheduler calls to draw an object part: `part` names the object slot of
-/// SceneObjects and the local-BSP node (a leaf, or an inner node whose whole subtree is
-/// drawn at once), and [firstIndex, firstIndex + indexCount) is that node's range of its
-/// model's split mesh.
+/// A part as drawn: `part` names the object slot of SceneObjects and the local-BSP node
+/// (a leaf, or an inner node whose whole subtree is drawn at once), and [firstIndex,
+/// firstIndex + indexCount) is that node's range of its model's split mesh.
+struct PartRange {
+    NodeRef part;
+    std::uint32_t firstIndex = 0;
+    std::uint32_t indexCount = 0;
+};
+
+/// What the scheduler calls to draw an object part. A sink that draws the parts itself
+/// (the engine's part renderer) may also test them on their own triangles, the strictest
+/// conservative test there is: a part none of whose fragments passes the depth test now
+/// shows nothing if drawn later, since depth only grows nearer.
 class PartSink {
 public:
     virtual ~PartSink() = default;
     virtual void drawPart(NodeRef part, std::uint32_t firstIndex, std::uint32_t indexCount) = 0;
+
+    /// Whether the three calls below work (false: the default, e.g. a game's own draws).
+    virtual bool testsTriangles() const { return false; }
+    /// From now to the end of the frame, every drawPart also records whether any fragment
+    /// of the part passed the depth test as it was drawn: the batched counterpart of a
+    /// query on the draw.
+    virtual void beginDrawMarks() {}
+    /// Those records, one per drawPart since beginDrawMarks in call order: Visible if a
+    /// fragment passed, else Occluded. Waits for the drawing. `out` has one entry per draw.
+    virtual void readDrawMarks(std::span<QueryResult> out) { std::fill(out.begin(), out.end(), QueryResult::Visible); }
+    /// Draws `parts` as drawPart would (the same positions, the same face culling) with
+    /// colour and depth writes off, against the depth drawn so far, and answers in `out`
+    /// (one per part, in order; waits for the drawing): Visible if any fragment passed.
+    /// Nothing is drawn into the image. A sink that cannot answers Visible.
+    virtual void testParts(std::span<const PartRange> parts, std::span<QueryResult> out) {
+        (void)parts;
+        std::fill(out.begin(), out.end(), QueryResult::Visible);
+    }
 };
 
 }  // namespace dyncull

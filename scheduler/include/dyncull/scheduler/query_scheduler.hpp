@@ -112,6 +112,16 @@ struct SchedulerParams {
     /// that turned hidden is not drawn early next frame. Off: such parts are drawn (the
     /// pyramid alone, an ablation).
     bool useBatchedRaster = true;
+    /// TwoPhase, where the PartSink can (PartSink::testsTriangles: the engine's part
+    /// renderer): a part that the volume tests let through is tested on its own triangles
+    /// before it is drawn (where the cost model expects it to pay), and every draw is
+    /// marked with whether it showed a sample, which replaces the volume test against the
+    /// final depth. The exact test on the geometry itself, where a volume around it peeks
+    /// out from behind occluders the part does not. Off by default: on llvmpipe a test
+    /// costs 1.3x drawing the same triangles and a marked draw 1.2x a plain one, so it
+    /// loses there (docs/BENCHMARKS.md); it pays where shading, not triangle set-up, is
+    /// what drawing costs.
+    bool useTriangleTests = false;
 
     /// TwoPhase's cost model: a volume the pyramid cannot reject is tested only where the
     /// test is expected to pay. Its cost is `testNsPerVolume` plus `testNsPerPixel` per
@@ -126,10 +136,16 @@ struct SchedulerParams {
     /// GL time; the defaults were measured on llvmpipe at 640x360 (`bench_draw_speed`,
     /// `bench_volume_tests`, and for the readback `full-hzb` against `vfc` on Sponza;
     /// docs/BENCHMARKS.md), and another GL needs its own.
+    /// A triangle test (useTriangleTests) costs `triangleTestNsPerPart` plus
+    /// `triangleTestNsPerTriangle` per triangle, and is weighed the same way; the default is
+    /// 1.3x drawNsPerTriangle, as measured (`bench_draw_speed`: test-hidden against parts),
+    /// so on llvmpipe only the exploring eighth of the parts is tested.
     struct TestCosts {
         double drawNsPerTriangle = 53.0;
         double testNsPerVolume = 5000.0;
         double testNsPerPixel = 1.5;
+        double triangleTestNsPerPart = 0.0;
+        double triangleTestNsPerTriangle = 69.0;
         double depthReadNs = 400000.0;
         std::uint32_t probeFrames = 16;
     };
@@ -269,8 +285,21 @@ private:
     };
     std::vector<TestedPart> candidates_, refresh_;
     /// The cost model's measured rates of "occluded" answers, for parts new this frame and
-    /// for parts drawn early and tested again (moving averages over frames).
-    double candidateOccludedRate_ = 0.5, refreshOccludedRate_ = 0.5;
+    /// for parts drawn early and tested again (moving averages over frames), and for the
+    /// triangle tests of parts whose volumes passed.
+    double candidateOccludedRate_ = 0.5, refreshOccludedRate_ = 0.5, triangleOccludedRate_ = 0.5;
+    // useTriangleTests: this frame's marked draws in order, the parts to test on their
+    // triangles, and the answers of either.
+    bool marking_ = false;
+    std::vector<NodeRef> markedDraws_;
+    std::vector<PartRange> triangleTests_;
+    std::vector<QueryResult> triangleAnswers_;
+    /// True if a triangle test of `ref` is expected to save more drawing than it costs.
+    bool worthTriangleTest(NodeRef ref);
+    /// Tests triangleTests_ (PartSink::testParts), draws the visible ones, records the answers.
+    void testTriangles();
+    /// Reads this frame's draw marks into each drawn part's history.
+    void readDrawMarks();
     /// The drawing (ns) that the last frame with tests saved, and that frame's number.
     double savedNs_ = 1e300;
     std::uint32_t lastTestedFrame_ = 0;
