@@ -4,6 +4,7 @@
 // matrix per object, re-evaluated after every dynamic change).
 #include "dyncull/bsp/scene_objects.hpp"
 
+#include <cassert>
 #include <string>
 
 namespace dyncull {
@@ -78,6 +79,7 @@ Expected<ObjectHandle> SceneObjects::addObject(ModelId model, const Transform& t
         placedAt_.push_back(0);
         alive_.push_back(0);
         static_.push_back(0);
+        role_.push_back(OcclusionRole::Both);
         movedFlag_.push_back(0);
     }
     model_[i] = model;
@@ -99,11 +101,24 @@ bool SceneObjects::alive(ObjectHandle h) const {
 Status SceneObjects::removeObject(ObjectHandle h) {
     if (!alive(h)) return Error{"removeObject: stale or invalid " + handleText(h)};
     const std::uint32_t i = h.index;
+    if (role_[i] != OcclusionRole::Both) {
+        role_[i] = OcclusionRole::Both;  // the slot's next object starts as Both
+        std::erase(roleSlots_, i);
+    }
     alive_[i] = 0;
     ++generation_[i];  // every handle to the old object is stale from now on
     freeSlots_.push_back(i);
     removed_.push_back(i);
     --live_;
+    return {};
+}
+
+Status SceneObjects::setRole(ObjectHandle h, OcclusionRole role) {
+    if (!alive(h)) return Error{"setRole: stale or invalid " + handleText(h)};
+    const std::uint32_t i = h.index;
+    if (role_[i] == OcclusionRole::Both && role != OcclusionRole::Both) roleSlots_.push_back(i);
+    if (role_[i] != OcclusionRole::Both && role == OcclusionRole::Both) std::erase(roleSlots_, i);
+    role_[i] = role;
     return {};
 }
 
@@ -136,8 +151,15 @@ Expected<ObjectHandle> SceneObjects::setModel(ObjectHandle h, ModelId model) {
     // Remove and add: the slot is reused at once, under the next generation.
     const Transform transform = transform_[h.index];
     const bool isStatic = static_[h.index] != 0;
+    const OcclusionRole role = role_[h.index];
     if (Status s = removeObject(h); !s) return s.error();
-    return addObject(model, transform, isStatic);
+    auto added = addObject(model, transform, isStatic);
+    if (added && role != OcclusionRole::Both) {
+        Status s = setRole(*added, role);
+        assert(s);
+        (void)s;
+    }
+    return added;
 }
 
 void SceneObjects::clearMoved() {

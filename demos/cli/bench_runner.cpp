@@ -385,7 +385,8 @@ FalsePositiveCauses BenchRunner::falsePositiveCauses() const {
             case NodeState::VisibleNear:
             case NodeState::VisibleFront:
             case NodeState::VisibleVfc:
-            case NodeState::VisibleCheaper: ++c.other; break;
+            case NodeState::VisibleCheaper:
+            case NodeState::VisibleOccluder: ++c.other; break;
         }
     }
     return c;

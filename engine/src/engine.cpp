@@ -31,7 +31,12 @@ struct Engine::Sink final : PartSink {
             e.callback_(handle, objs.modelOf(object), firstIndex, indexCount, objs.matrix(object));
             return;
         }
+        // An occludee-only object occludes nothing: drawn without depth writes (after
+        // everything that occludes, as the scheduler orders it).
+        const bool occludee = objs.role(object) == OcclusionRole::OccludeeOnly;
+        if (occludee) glDepthMask(GL_FALSE);
         render({part, firstIndex, indexCount}, marking ? e.marks_->nextDrawSlot() : Renderer::kNoMark);
+        if (occludee) glDepthMask(GL_TRUE);
     }
     void render(const PartRange& p, std::uint32_t markSlot) {
         const SceneObjects& objs = e.objects_;
@@ -212,6 +217,8 @@ Expected<ModelId> Engine::addModel(LocalBsp bsp) {
 Expected<ObjectHandle> Engine::addObject(ModelId model, const Transform& transform, bool isStatic) {
     return objects_.addObject(model, transform, isStatic);
 }
+
+Status Engine::setRole(ObjectHandle object, OcclusionRole role) { return objects_.setRole(object, role); }
 
 Status Engine::removeObject(ObjectHandle object) {
     if (Status s = objects_.removeObject(object); !s) return s;

@@ -41,6 +41,7 @@ const char* toString(NodeState s) {
         case NodeState::VisibleFront: return "visible_front";
         case NodeState::VisibleVfc: return "visible_vfc";
         case NodeState::VisibleCheaper: return "visible_cheaper";
+        case NodeState::VisibleOccluder: return "visible_occluder";
     }
     return "?";
 }
@@ -119,12 +120,14 @@ FrameStats QueryScheduler::cullFrame(const TwoLevelTree& tree, const FrameView& 
         for (const Pending& p : drawQueries_) backend.release(p.id);
         drawQueries_.clear();
     }
+    drawOccluders();
     switch (params_.mode) {
         case CullMode::Vfc: runVfc(); break;
         case CullMode::Simple: runSimple(); break;
         case CullMode::Queries: runQueries(); break;
         case CullMode::TwoPhase: runTwoPhase(); break;
     }
+    drawOccludees();
     st.traversalMs = std::max(0.0, msSince(t0) - st.waitMs - st.drawMs - st.queryMs - st.depthReadMs);
     stats_ = nullptr;
     return st;
@@ -326,10 +329,7 @@ void QueryScheduler::processVisible(NodeRef ref, NodeHistory& h, bool untested) 
         drawNode(ref, untested);
         return;
     }
-    scratch_.clear();
-    tree_->expand(ref, camera_.position, scratch_);
-    // active_ is a stack whose back is processed next: push the farthest first.
-    for (auto it = scratch_.rbegin(); it != scratch_.rend(); ++it) active_.push_back(*it);
+    pushChildren(ref);
 }
 
 std::uint32_t QueryScheduler::countFrustumLeaves() const {

@@ -81,9 +81,7 @@ void QueryScheduler::runTwoPhase() {
         if (frustum_.outside(tree_->worldBox(ref))) continue;
         NodeHistory& h = history_.at(ref, objs);
         if (!tree_->isDrawable(ref)) {
-            scratch_.clear();
-            tree_->expand(ref, camera_.position, scratch_);
-            for (auto it = scratch_.rbegin(); it != scratch_.rend(); ++it) active_.push_back(*it);
+            pushChildren(ref);
             continue;
         }
         if (h.lastVisible && h.lastVisibleFrame + 1 == frame_) {
@@ -167,9 +165,7 @@ void QueryScheduler::runTwoPhase() {
         h.lastVisibleFrame = frame_;
         if (!tree_->isDrawable(ref)) {
             note(certain ? NodeState::VisibleNear : NodeState::VisibleQueried);
-            scratch_.clear();
-            tree_->expand(ref, camera_.position, scratch_);
-            for (auto it = scratch_.rbegin(); it != scratch_.rend(); ++it) active_.push_back(*it);
+            pushChildren(ref);
         } else if (drawnEarly) {
             if (!raster || certain || triangles) continue;  // marks answer for it with triangles
             // Visibility history, as in Queries: a part that kept answering "visible" is

@@ -25,6 +25,16 @@ struct ObjectHandle {
 
 using ModelId = std::uint32_t;
 
+/// What an object does in occlusion culling. Both: it is tested, and its depth occludes
+/// what lies behind it (the default). OccluderOnly: never tested; whenever its box meets the
+/// frustum it is drawn whole, first (before any test of the frame), so its depth occludes
+/// from the start: terrain, a building's shell, anything almost always seen.
+/// OccludeeOnly: tested, but its depth occludes nothing: it is drawn whole, last, after
+/// every other object, if a test against their final depth shows it, and without depth
+/// writes (the part renderer; a game's callback must draw it so too): glass, particles,
+/// anything blended.
+enum class OcclusionRole : std::uint8_t { Both, OccluderOnly, OccludeeOnly };
+
 /// Owns models and objects. Slots of removed objects go on a free list and their
 /// generation is bumped so stale handles are detected.
 class SceneObjects {
@@ -51,6 +61,8 @@ public:
     /// relink, no motion check anywhere downstream).
     Expected<ObjectHandle> addObject(ModelId model, const Transform& transform, bool isStatic = false);
     Status removeObject(ObjectHandle h);
+    /// Sets the object's OcclusionRole (Both when added; kept by setModel). Error: stale handle.
+    Status setRole(ObjectHandle h, OcclusionRole role);
     /// Sets a new world transform; marks the object moved for this frame's relink. Errors:
     /// stale handle, invalid transform, or a static object.
     Status setTransform(ObjectHandle h, const Transform& transform);
@@ -65,6 +77,10 @@ public:
     const Transform& transform(std::uint32_t i) const { return transform_[i]; }
     const Aabb& worldBox(std::uint32_t i) const { return worldBox_[i]; }  ///< world space
     bool isStatic(std::uint32_t i) const { return static_[i] != 0; }
+    OcclusionRole role(std::uint32_t i) const { return role_[i]; }
+    /// The live slots whose role is not Both, in no particular order: the scheduler handles
+    /// them apart from the tree's traversal without scanning every object.
+    const std::vector<std::uint32_t>& roleSlots() const { return roleSlots_; }
     /// When the slot was last placed (addObject or setTransform), as a value of one counter
     /// shared by every slot: a consumer that keeps it sees a move, or the slot's reuse by a
     /// new object, as a different value, without comparing matrices.
@@ -90,7 +106,8 @@ private:
     std::vector<std::uint64_t> placedAt_;
     std::uint64_t placements_ = 0;
     std::vector<std::uint8_t> alive_, static_, movedFlag_;
-    std::vector<std::uint32_t> freeSlots_, moved_, added_, removed_;
+    std::vector<OcclusionRole> role_;
+    std::vector<std::uint32_t> freeSlots_, moved_, added_, removed_, roleSlots_;
     std::uint32_t live_ = 0;
 };
 

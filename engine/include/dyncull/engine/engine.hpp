@@ -43,7 +43,8 @@ struct EngineOptions {
 /// and the split mesh's indices. Called inside renderFrame, into the caller's framebuffer
 /// and viewport, with the frame contract's state (frame_contract.hpp): the callback may
 /// bind its own program, vertex array, buffers and textures (restored after the frame) and
-/// must keep the depth test and reversed-Z convention.
+/// must keep the depth test and reversed-Z convention. An occludee-only object
+/// (OcclusionRole, setRole) comes last in the frame and must be drawn without depth writes.
 using DrawPartCallback =
     std::function<void(ObjectHandle object, ModelId model, std::uint32_t firstIndex, std::uint32_t indexCount,
                        const glm::mat4& objectToWorld)>;
@@ -103,6 +104,10 @@ public:
     /// and costs nothing per frame).
     Expected<ObjectHandle> addObject(ModelId model, const Transform& transform, bool isStatic = false);
     Status removeObject(ObjectHandle object);
+    /// Makes an object occluder-only (never tested, drawn whole and first when in the
+    /// frustum) or occludee-only (tested against everything else, drawn whole and last,
+    /// without depth writes), or Both again; see OcclusionRole. Error: stale handle.
+    Status setRole(ObjectHandle object, OcclusionRole role);
     /// Frees a model no object uses, with its GPU copy (part renderer). To replace a model:
     /// add the new one, move its objects over with setModel, remove the old one.
     /// Errors: unknown or removed model, objects still using it, the context not current.

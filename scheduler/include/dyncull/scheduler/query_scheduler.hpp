@@ -167,6 +167,7 @@ enum class NodeState : std::uint8_t {
     VisibleFront,       ///< drawn without a query: among the front-most frontPercent leaves
     VisibleVfc,         ///< vfc mode: in the frustum
     VisibleCheaper,     ///< two-phase: drawn untested, since the cost model expects the test to cost more than it saves
+    VisibleOccluder,    ///< an occluder-only object (OcclusionRole): drawn whole and untested whenever in the frustum
 };
 const char* toString(NodeState s);
 
@@ -247,6 +248,14 @@ private:
     void runSimple();
     void runQueries();
     void runTwoPhase();  // two_phase.cpp
+    // Objects with an OcclusionRole (object_roles.cpp): occluder-only ones drawn before the
+    // mode's traversal, occludee-only ones tested against the final depth and drawn after.
+    void drawOccluders();
+    void drawOccludees();
+    /// Pushes `ref`'s children front to back onto active_ (the nearest on top), leaving out
+    /// objects with a role, which the traversal never reaches.
+    void pushChildren(NodeRef ref);
+    std::vector<std::pair<float, std::uint32_t>> roleOrder_;  // (distance, slot), per frame
     /// A query volume's screen rectangle and nearest window depth (reversed Z: the largest
     /// of its points'), the volume grown by its vertices' rounding first; false if it
     /// reaches the near plane (then it is simply visible).
