@@ -292,10 +292,11 @@ Expected<FrameStats> Engine::renderView(ViewId id) {
 
 Expected<FrameStats> Engine::renderFrame(QueryScheduler& scheduler) { return cullAndDraw(views_[kMainView], scheduler); }
 
-Expected<FrameStats> Engine::cullAndDraw(View& view, QueryScheduler& scheduler) {
+template <class Draw>
+Expected<FrameStats> Engine::drawFrame(View& view, const char* what, Draw draw) {
     view.visible.begin(objects_.slotCount());  // a refused frame draws nothing
-    if (Status s = checkDrawer("renderFrame"); !s) return s.error();
-    if (Status s = enterGl("renderFrame"); !s) return s.error();
+    if (Status s = checkDrawer(what); !s) return s.error();
+    if (Status s = enterGl(what); !s) return s.error();
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();
     const double updateMs = updateSceneTree().updateMs;  // once per frame: later views find nothing moved
@@ -307,50 +308,42 @@ Expected<FrameStats> Engine::cullAndDraw(View& view, QueryScheduler& scheduler) 
     const FrameView frame = FrameView::of(view.camera, target.width(), target.height());
     if (renderer_) renderer_->beginFrame(frame);
     Sink sink(*this, view.visible);
-    TwoLevelTree tree(tree_, objects_);
-    FrameStats st = scheduler.cullFrame(tree, frame, *backend_, sink);
+    FrameStats st = draw(frame, sink);
     if (renderer_) renderer_->endFrame();
     if (finishEachFrame_) glFinish();
     scope.restore();
     // A reset during the frame: its image and query results are undefined, so report it.
-    if (Status s = leaveGl("renderFrame"); !s) return s.error();
+    if (Status s = leaveGl(what); !s) return s.error();
     if (!backend_->frameStatus()) return backend_->frameStatus().error();
     st.updateMs = updateMs;
     st.frameMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
     return st;
 }
 
+Expected<FrameStats> Engine::cullAndDraw(View& view, QueryScheduler& scheduler) {
+    return drawFrame(view, "renderFrame", [&](const FrameView& frame, Sink& sink) {
+        TwoLevelTree tree(tree_, objects_);
+        return scheduler.cullFrame(tree, frame, *backend_, sink);
+    });
+}
+
 Expected<FrameStats> Engine::renderParts(const std::vector<NodeRef>& parts) {
-    View& view = views_[kMainView];
-    view.visible.begin(objects_.slotCount());
-    if (Status s = checkDrawer("renderParts"); !s) return s.error();
-    if (Status s = enterGl("renderParts"); !s) return s.error();
-    using Clock = std::chrono::steady_clock;
-    const auto t0 = Clock::now();
-    const double updateMs = updateSceneTree().updateMs;
-    detail::GlStateScope scope;
-    if (renderer_) renderer_->beginFrame(view.camera);
-    Sink sink(*this, view.visible);
-    FrameStats st;
-    const auto tDraw = Clock::now();
-    for (const NodeRef& ref : parts) {
-        assert(!ref.isSceneNode() && ref.object < objects_.slotCount() && objects_.alive(ref.object));
-        const LocalBsp& bsp = objects_.model(objects_.modelOf(ref.object));
-        assert(ref.node < bsp.nodes.size());
-        const LocalBspNode& n = bsp.nodes[ref.node];
-        sink.drawPart(ref, n.firstIndex, n.indexCount);
-        ++st.partsDrawn;
-        st.trianglesDrawn += n.indexCount / 3;
-    }
-    st.drawMs = std::chrono::duration<double, std::milli>(Clock::now() - tDraw).count();
-    st.nodesVisited = st.partsDrawn;
-    if (renderer_) renderer_->endFrame();
-    if (finishEachFrame_) glFinish();
-    scope.restore();
-    if (Status s = leaveGl("renderParts"); !s) return s.error();
-    st.updateMs = updateMs;
-    st.frameMs = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-    return st;
+    return drawFrame(views_[kMainView], "renderParts", [&](const FrameView&, Sink& sink) {
+        FrameStats st;
+        const auto tDraw = std::chrono::steady_clock::now();
+        for (const NodeRef& ref : parts) {
+            assert(!ref.isSceneNode() && ref.object < objects_.slotCount() && objects_.alive(ref.object));
+            const LocalBsp& bsp = objects_.model(objects_.modelOf(ref.object));
+            assert(ref.node < bsp.nodes.size());
+            const LocalBspNode& n = bsp.nodes[ref.node];
+            sink.drawPart(ref, n.firstIndex, n.indexCount);
+            ++st.partsDrawn;
+            st.trianglesDrawn += n.indexCount / 3;
+        }
+        st.drawMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tDraw).count();
+        st.nodesVisited = st.partsDrawn;
+        return st;
+    });
 }
 
 }  // namespace dyncull

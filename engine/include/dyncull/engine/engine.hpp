@@ -214,6 +214,11 @@ private:
     const View* findView(ViewId id) const;
     /// One frame of `view` with `scheduler`, into the bound framebuffer and viewport.
     Expected<FrameStats> cullAndDraw(View& view, QueryScheduler& scheduler);
+    /// The frame around `draw(frameView, sink)`, which returns the frame's stats: checks,
+    /// relink, GL state scope, renderer frame, finish and error checks, times. renderParts
+    /// and cullAndDraw differ only in `draw`.
+    template <class Draw>
+    Expected<FrameStats> drawFrame(View& view, const char* what, Draw draw);
     /// Before a call's GL work: the context is current and not lost; the caller's pending
     /// GL errors are set aside (callerGlErrors_).
     Status enterGl(const char* what);
