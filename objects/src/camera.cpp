@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <numbers>
 
+#include <glm/gtc/matrix_access.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
 namespace dyncull {
@@ -25,8 +26,23 @@ glm::dmat4 reversedZPerspective(double fovY, double aspect, double n, double f) 
     return p;
 }
 
+glm::dmat4 reversedZOrthographic(double height, double aspect, double n, double f) {
+    glm::dmat4 p(1.0);
+    p[0][0] = 2.0 / (aspect * height);
+    p[1][1] = 2.0 / height;
+    p[2][2] = 1.0 / (f - n);  // clip z = (f - d) / (f - n) with d = -z_view: 1 at near, 0 at far
+    p[3][2] = f / (f - n);
+    return p;  // clip w = 1
+}
+
 glm::dmat4 Camera::projectionDouble() const {
+    if (orthographic()) return reversedZOrthographic(orthoHeight, aspect, nearPlane, farPlane);
     return reversedZPerspective(fovYRadians, aspect, nearPlane, farPlane);
+}
+
+glm::dvec4 Camera::distanceRowRelative() const {
+    if (!orthographic()) return glm::row(viewProjectionRelativeDouble(), 3);  // clip w
+    return glm::dvec4(glm::normalize(glm::dvec3(target) - glm::dvec3(position)), 0.0);
 }
 
 glm::mat4 Camera::viewProjection() const {
@@ -100,6 +116,8 @@ Status validateCamera(const Camera& c) {
     if (!std::isfinite(c.fovYRadians) || c.fovYRadians <= 0.0f || c.fovYRadians >= std::numbers::pi_v<float>)
         return Error{"camera: vertical field of view must be in (0, pi) radians"};
     if (!std::isfinite(c.aspect) || c.aspect <= 0.0f) return Error{"camera: aspect must be positive"};
+    if (!std::isfinite(c.orthoHeight) || c.orthoHeight < 0.0f)
+        return Error{"camera: orthographic height must be finite and positive (0: perspective)"};
     if (!std::isfinite(c.nearPlane) || !std::isfinite(c.farPlane) || c.nearPlane <= 0.0f || c.farPlane <= c.nearPlane)
         return Error{"camera: need 0 < near < far"};
     const glm::vec3 f = c.target - c.position;

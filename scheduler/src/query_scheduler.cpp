@@ -86,6 +86,7 @@ FrameStats QueryScheduler::cullFrame(const TwoLevelTree& tree, const FrameView& 
     // Camera-relative (eye at the origin, set up in double): precise at any distance from
     // the world origin, like the renderer's and the query backend's transforms.
     viewProj_ = view.viewProjRelative;
+    distanceRow_ = camera.distanceRowRelative();
     frustum_ = view.frustum;
     width_ = width;
     height_ = height;
@@ -165,8 +166,8 @@ QueryResult QueryScheduler::timedPoll(QueryId id) {
 bool QueryScheduler::projectRect(const Aabb& box, ScreenRect& out) const {
     // Project the box clipped to the near plane, so boxes crossing it still get a correct
     // (conservative) rectangle. Returns false if the box crosses the near plane.
-    // Double and camera-relative: clip w is the view distance along the view direction,
-    // so the near test compares distances directly (no depth terms of the projection,
+    // Double and camera-relative: the near test compares distances along the view direction
+    // directly (clip w in perspective) (no depth terms of the projection,
     // which at near 1e-4 and far 1e7 span 11 orders of magnitude).
     const glm::dvec3 eye(camera_.position);
     const glm::dvec3 lo3 = glm::dvec3(box.min) - eye, hi3 = glm::dvec3(box.max) - eye;
@@ -183,17 +184,19 @@ bool QueryScheduler::projectRect(const Aabb& box, ScreenRect& out) const {
     const double nearTest = nearPlane + 0x1p-21 * magnitude(glm::dvec3(box.min), glm::dvec3(box.max)) +
                             0x1p-22 * (magnitude(lo3, hi3) + nearPlane);
     glm::dvec4 clip[8];
+    double distance[8];  // along the view direction
     bool front[8];  // in front of the near plane itself: part of the rectangle
     bool crosses = false;
     for (int i = 0; i < 8; ++i) {
         const glm::dvec3 c((i & 1) ? hi3.x : lo3.x, (i & 2) ? hi3.y : lo3.y, (i & 4) ? hi3.z : lo3.z);
         clip[i] = viewProj_ * glm::dvec4(c, 1.0);
-        front[i] = clip[i].w >= nearPlane;
-        crosses |= clip[i].w < nearTest;
+        distance[i] = viewDistance(clip[i], c);
+        front[i] = distance[i] >= nearPlane;
+        crosses |= distance[i] < nearTest;
     }
     glm::dvec2 lo(1e300), hi(-1e300);
     auto addPoint = [&](const glm::dvec4& p) {
-        const glm::dvec2 ndc = glm::dvec2(p) / p.w;  // w >= near > 0 for every point added
+        const glm::dvec2 ndc = glm::dvec2(p) / p.w;  // w >= near > 0 (perspective) or 1 for every point added
         lo = glm::min(lo, ndc);
         hi = glm::max(hi, ndc);
     };
@@ -205,7 +208,7 @@ bool QueryScheduler::projectRect(const Aabb& box, ScreenRect& out) const {
             for (int bit = 1; bit < 8; bit <<= 1) {
                 const int j = i | bit;
                 if (j == i || front[i] == front[j]) continue;
-                const double t = (clip[i].w - nearPlane) / (clip[i].w - clip[j].w);
+                const double t = (distance[i] - nearPlane) / (distance[i] - distance[j]);
                 addPoint(clip[i] + (clip[j] - clip[i]) * t);
             }
     }

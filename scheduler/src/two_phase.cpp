@@ -51,7 +51,7 @@ bool QueryScheduler::projectVolumeDepth(const QueryVolume& volume, ScreenRect& r
     double nearest = 0.0;
     for (std::uint32_t i = 0; i < n; ++i) {
         const glm::dvec4 clip = viewProj_ * glm::dvec4(rel[i], 1.0);
-        if (clip.w < nearTest) return false;
+        if (viewDistance(clip, rel[i]) < nearTest) return false;
         const glm::dvec2 ndc = glm::dvec2(clip) / clip.w;
         lo = glm::min(lo, ndc);
         hi = glm::max(hi, ndc);

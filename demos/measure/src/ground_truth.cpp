@@ -46,14 +46,15 @@ glm::vec2 GroundTruth::windowDepthRange(const SceneObjects& objects, NodeRef ref
     const Aabb local = objects.model(model).nodes[ref.node].box;
     const glm::dmat4 m(objects.matrix(ref.object));
     const glm::dvec3 eye(camera.position);
+    const glm::dvec4 distanceRow = camera.distanceRowRelative();
     double lo = 2.0, hi = -1.0;
     for (int c = 0; c < 8; ++c) {
         const glm::dvec3 p((c & 1) ? local.max.x : local.min.x, (c & 2) ? local.max.y : local.min.y,
                            (c & 4) ? local.max.z : local.min.z);
-        const glm::dvec4 clip = viewProj * glm::dvec4(glm::dvec3(m * glm::dvec4(p, 1.0)) - eye, 1.0);
-        // A corner at or behind the near plane (clip w is the view distance): the clipped
-        // part may have any depth.
-        if (!(clip.w > double(camera.nearPlane))) return {-1.0f, 2.0f};
+        const glm::dvec4 rel(glm::dvec3(m * glm::dvec4(p, 1.0)) - eye, 1.0);
+        const glm::dvec4 clip = viewProj * rel;
+        // A corner at or behind the near plane: the clipped part may have any depth.
+        if (!(glm::dot(distanceRow, rel) > double(camera.nearPlane))) return {-1.0f, 2.0f};
         const double z = clip.z / clip.w;  // window depth: reversed Z, GL_ZERO_TO_ONE, no remap
         lo = std::min(lo, z);
         hi = std::max(hi, z);

@@ -1,5 +1,5 @@
-// Perspective camera and view frustum (world space, right-handed; the camera looks down -Z
-// in view space).
+// Perspective or orthographic camera and view frustum (world space, right-handed; the camera
+// looks down -Z in view space).
 //
 // Depth convention: reversed Z with zero-to-one depth. Clip x and y are OpenGL's [-w, w];
 // clip z / w is 1 at the near plane and 0 at the far plane. The engine renders with
@@ -29,6 +29,10 @@ struct Camera {
     float aspect = 16.0f / 9.0f;  ///< width / height
     float nearPlane = 0.05f;  ///< world units, > 0
     float farPlane = 1000.0f;  ///< world units, > nearPlane
+    /// > 0: an orthographic camera showing this many world units from the bottom of the view
+    /// to its top (a directional light's shadow map; fovYRadians is then unused); 0: perspective.
+    float orthoHeight = 0.0f;
+    bool orthographic() const { return orthoHeight > 0.0f; }
 
     /// World to view space (eye at the origin, looking down -Z), world units.
     glm::mat4 view() const;
@@ -50,6 +54,11 @@ struct Camera {
     /// object-to-camera-relative matrix to pair with viewProjectionRelative().
     glm::mat4 relativeModel(const glm::mat4& objectToWorld) const;
     glm::vec3 forward() const;
+    /// The row r with dot(r, (p, 1)) = p's distance along the view direction (world units)
+    /// for a point p relative to the eye: clip w of viewProjectionRelativeDouble for a
+    /// perspective camera (the same rounding as the projection), the unit view direction
+    /// for an orthographic one (whose clip w is 1). What near-plane tests compare with nearPlane.
+    glm::dvec4 distanceRowRelative() const;
 
     /// Camera placed to see all of `box` from direction `dir`, near/far fitted to it.
     static Camera framing(const Aabb& box, float aspect, const glm::vec3& dir = {0.6f, 0.45f, 1.0f});
@@ -63,7 +72,12 @@ struct Camera {
 /// radians, aspect = width / height; needs 0 < near < far.
 glm::dmat4 reversedZPerspective(double fovY, double aspect, double nearPlane, double farPlane);
 
-/// Rejects NaN/Inf, near <= 0, far <= near, degenerate up/target, fov outside (0, pi).
+/// Reversed-Z orthographic projection with zero-to-one depth: view space to clip space with
+/// clip w = 1, x and y in [-1, 1] over `height` x `height * aspect` units, clip z = (far - d) /
+/// (far - near) for view distance d: 1 at near, 0 at far (linear). Needs near < far.
+glm::dmat4 reversedZOrthographic(double height, double aspect, double nearPlane, double farPlane);
+/// Rejects NaN/Inf, near <= 0, far <= near, degenerate up/target, fov outside (0, pi), a
+/// negative or non-finite orthographic height.
 Status validateCamera(const Camera& camera);
 
 /// Whether Camera::framing can show `worldBounds` (world units) as a picture: the box must be

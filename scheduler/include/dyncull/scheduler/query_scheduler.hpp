@@ -275,6 +275,12 @@ private:
     PartSink* sink_ = nullptr;
     Camera camera_;
     glm::dmat4 viewProj_{1.0};  // camera-relative (Camera::viewProjectionRelativeDouble)
+    glm::dvec4 distanceRow_{0.0};  // Camera::distanceRowRelative
+    /// The distance along the view direction of eye-relative point `rel` whose clip
+    /// coordinates are `clip`: clip w in perspective, along distanceRow_ in orthographic.
+    double viewDistance(const glm::dvec4& clip, const glm::dvec3& rel) const {
+        return camera_.orthographic() ? glm::dot(distanceRow_, glm::dvec4(rel, 1.0)) : clip.w;
+    }
     Frustum frustum_;
     int width_ = 0, height_ = 0;
     FrameStats* stats_ = nullptr;
