@@ -9,7 +9,11 @@
 //
 // --cull none draws every object without asking dyncull. --check draws the last frame
 // that way too and compares: a conservative mode must give the same picture (the program
-// fails if more than 0.01% of the pixels differ).
+// fails if more than 0.01% of the pixels differ). It then draws the same frame with
+// dyncull's own part renderer (a second engine on the same context): its shading is
+// dyncull's, but its surfaces must be the game's, so the depth buffers must agree (again
+// at most 0.01% of the pixels apart).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -260,6 +264,12 @@ int main(int argc, char** argv) {
         glClearDepth(0.0);  // reversed Z: 0 is the far plane
         glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     };
+    auto readDepth = [&] {
+        std::vector<float> depth(std::size_t{kWidth} * kHeight);
+        glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+        glReadPixels(0, 0, kWidth, kHeight, GL_DEPTH_COMPONENT, GL_FLOAT, depth.data());
+        return depth;
+    };
     auto readFrame = [&] {
         std::vector<unsigned char> rgba(std::size_t{kWidth} * kHeight * 4);
         glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
@@ -301,6 +311,38 @@ int main(int argc, char** argv) {
         const double percent = 100.0 * double(differ) / double(kWidth * kHeight);
         std::printf("check: %zu of %d pixels (%.4f%%) differ from drawing every object\n", differ, kWidth * kHeight, percent);
         if (percent > 0.01) return 1;
+
+        // The same frame through dyncull's own renderer: the same models, placements and camera.
+        dyncull::EngineOptions ownOptions;
+        ownOptions.scheduler = options.scheduler;
+        auto own = dyncull::Engine::create(**gl, ownOptions);
+        if (!own) fail(own.error().message);
+        auto ownRing = (*own)->addModel(ring.shape, split);
+        auto ownWall = (*own)->addModel(screen.shape);
+        if (!ownRing || !ownWall) fail("own renderer: cannot add the models");
+        const dyncull::SceneObjects& objects = engine.objects();
+        for (std::uint32_t i = 0; i < objects.slotCount(); ++i) {
+            if (!objects.alive(i)) continue;
+            const dyncull::ModelId model = objects.modelOf(i) == *ringModel ? *ownRing : *ownWall;
+            if (auto h = (*own)->addObject(model, objects.transform(i)); !h) fail(h.error().message);
+        }
+        if (dyncull::Status s = (*own)->setCamera(camera); !s) fail(s.message());
+        clearFrame();
+        if (cull == "none") drawEverything();
+        else if (auto st = engine.renderFrame(); !st) fail(st.error().message);
+        const std::vector<float> gameDepth = readDepth();
+        clearFrame();
+        if (auto st = (*own)->renderFrame(); !st) fail(st.error().message);
+        const std::vector<float> ownDepth = readDepth();
+        // The game transforms in world space, dyncull relative to the eye: a few float
+        // roundings apart at most.
+        std::size_t depthDiffer = 0;
+        for (std::size_t i = 0; i < gameDepth.size(); ++i)
+            depthDiffer += std::abs(gameDepth[i] - ownDepth[i]) > 1e-5f * std::max(gameDepth[i], ownDepth[i]);
+        const double depthPercent = 100.0 * double(depthDiffer) / double(kWidth * kHeight);
+        std::printf("check: %zu of %d pixels (%.4f%%) differ in depth from dyncull's own renderer\n", depthDiffer,
+                    kWidth * kHeight, depthPercent);
+        if (depthPercent > 0.01) return 1;
     }
     return 0;
 }
