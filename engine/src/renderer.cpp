@@ -32,7 +32,7 @@ Expected<std::unique_ptr<Renderer>> Renderer::create(GlContext& context) {
             p.model = glGetUniformLocation(p.id, "uModel");
             p.normalMat = glGetUniformLocation(p.id, "uNormalMat");
             p.colour = glGetUniformLocation(p.id, "uColour");
-            p.eye = glGetUniformLocation(p.id, "uEye");  // -1 in the per-vertex program (the eye is the origin)
+            p.viewer = glGetUniformLocation(p.id, "uViewer");
             p.light = glGetUniformLocation(p.id, "uLightDir");
             p.markSlot = glGetUniformLocation(p.id, "uMarkSlot");  // -1 in the plain variant
         }
@@ -153,11 +153,13 @@ void Renderer::beginFrame(const FrameView& view) {
     const glm::vec3 light = glm::normalize(-f + 0.9f * up - 0.6f * right);
 
     // Both variants get the frame's uniforms: a frame may mix marked and plain draws.
-    const glm::vec3 eyeRelative(0.0f);
+    // Towards the viewer: from the eye at the origin (camera-relative), or along the view
+    // direction for an orthographic camera, whose eye is at infinity.
+    const glm::vec4 viewer = camera.orthographic() ? glm::vec4(-camera.forward(), 0.0f) : glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
     for (const LitProgram& p : programs_[static_cast<int>(shading_)]) {
         glUseProgram(p.id);
         glUniformMatrix4fv(p.viewProj, 1, GL_FALSE, glm::value_ptr(viewProjRel));
-        if (p.eye >= 0) glUniform3fv(p.eye, 1, glm::value_ptr(eyeRelative));
+        glUniform4fv(p.viewer, 1, glm::value_ptr(viewer));
         glUniform3fv(p.light, 1, glm::value_ptr(light));
     }
     glUseProgram(testProgram_.id);

@@ -22,13 +22,14 @@ uniform mat4 uViewProj;
 uniform mat4 uModel;
 uniform mat3 uNormalMat;
 uniform vec3 uLightDir;  // towards the light, unit, world space
+uniform vec4 uViewer;    // the eye (0, 0, 0, 1: eye-relative) or, orthographic, the direction towards it (w = 0)
 out float vIntensity;
 invariant gl_Position;  // as kTriangleTestVertexShader's, so a test sees the drawn fragments
 void main() {
     vec4 world = uModel * vec4(aPosition, 1.0);  // relative to the eye (camera-relative)
     gl_Position = uViewProj * world;
     vec3 n = normalize(uNormalMat * aNormal);
-    float nv = dot(n, normalize(-world.xyz));
+    float nv = dot(n, normalize(uViewer.xyz - world.xyz * uViewer.w));
     if (nv < 0.0) { n = -n; nv = -nv; }
     float key = max(dot(n, uLightDir), 0.0);
     float hemi = 0.5 + 0.5 * n.y;
@@ -70,12 +71,12 @@ DYNCULL_MARKS_DECLARATION
 in vec3 vWorldPos;
 in vec3 vNormal;
 uniform vec3 uColour;
-uniform vec3 uEye;
+uniform vec4 uViewer;  // the eye (0, 0, 0, 1: eye-relative) or, orthographic, the direction towards it (w = 0)
 uniform vec3 uLightDir;  // towards the light, unit, world space
 out vec4 fragColour;
 void main() {
     vec3 n = normalize(vNormal);
-    vec3 v = normalize(uEye - vWorldPos);
+    vec3 v = normalize(uViewer.xyz - vWorldPos * uViewer.w);
     if (dot(n, v) < 0.0) n = -n;
     float key = max(dot(n, uLightDir), 0.0);
     float hemi = 0.5 + 0.5 * n.y;

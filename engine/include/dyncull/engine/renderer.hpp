@@ -131,7 +131,7 @@ private:
     };
     struct LitProgram {
         std::uint32_t id = 0;
-        int viewProj = -1, model = -1, normalMat = -1, colour = -1, eye = -1, light = -1, markSlot = -1;
+        int viewProj = -1, model = -1, normalMat = -1, colour = -1, viewer = -1, light = -1, markSlot = -1;
     };
     GlContext& context_;
     std::vector<GpuMesh> meshes_;
