@@ -193,6 +193,7 @@ Expected<LocalBsp> buildLocalBsp(const Mesh& mesh, const LocalBspParams& params)
     if (params.optimizeOrder) optimizeLeafOrder(bsp);
     bsp.stats.trianglesAfter = bsp.mesh.triangleCount();
     bsp.volumes = buildNodeVolumes(bsp.mesh, bsp.nodes);
+    bsp.clusters = clustersOf(bsp.mesh, bsp.nodes);
     bsp.stats.buildMs =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return bsp;

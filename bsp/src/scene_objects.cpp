@@ -21,6 +21,7 @@ ModelId SceneObjects::addModel(LocalBsp bsp) {
     assert(!bsp.nodes.empty() && "a LocalBsp always has a root node");
     // Cache-loaded or hand-made trees arrive without volumes; every model has them after this.
     if (bsp.volumes.nodeCount() != bsp.nodes.size()) bsp.volumes = buildNodeVolumes(bsp.mesh, bsp.nodes);
+    if (!bsp.clusters.builtFor(bsp.nodes.size())) bsp.clusters = clustersOf(bsp.mesh, bsp.nodes);
     models_.push_back(std::make_unique<LocalBsp>(std::move(bsp)));
     modelAlive_.push_back(1);
     return static_cast<ModelId>(models_.size() - 1);
@@ -38,6 +39,7 @@ Status SceneObjects::removeModel(ModelId id) {
     empty.mesh.name = models_[id]->mesh.name;
     empty.nodes.emplace_back();
     empty.volumes = buildNodeVolumes(empty.mesh, empty.nodes);
+    empty.clusters = clustersOf(empty.mesh, empty.nodes);
     *models_[id] = std::move(empty);
     modelAlive_[id] = 0;
     return {};

@@ -49,7 +49,8 @@ ModeSpec queriesMode(const std::string& name) {
 
 /// `full` and its ablations (two-phase), or false.
 bool applyTwoPhaseName(const std::string& part, ModeSpec& m) {
-    if (part != "full" && part != "full-hzb" && part != "full-nohist" && part != "full-nocost" && part != "full-tri")
+    if (part != "full" && part != "full-hzb" && part != "full-nohist" && part != "full-nocost" && part != "full-tri" &&
+        part != "full-noclusters")
         return false;
     m.scheduler.mode = CullMode::TwoPhase;
     m.scheduler.useBatchedRaster = part != "full-hzb";
@@ -62,6 +63,7 @@ bool applyTwoPhaseName(const std::string& part, ModeSpec& m) {
     }
     m.scheduler.useHistory = part != "full-nohist";
     m.scheduler.useCostModel = part != "full-nocost";
+    m.scheduler.useClusters = part != "full-noclusters";
     return true;
 }
 
@@ -70,7 +72,8 @@ bool applyTwoPhaseName(const std::string& part, ModeSpec& m) {
 std::string modeNamesHelp() {
     return "vfc, simple, full (two-phase: draw last frame's visible parts, test the rest against their depth pyramid, then what it cannot reject in one batched raster test where that pays), "
            "queries (hardware occlusion queries with history, batching and occupancy maps; the default before two-phase), oracle; "
-           "ablations of full: full-hzb (the pyramid alone), full-tri (every part whose volume passes then tested on its own triangles, and draws marked), full-nohist (every part drawn early tested again each frame), full-nocost (every volume the pyramid lets through tested); "
+           "ablations of full: full-hzb (the pyramid alone), full-tri (every part whose volume passes then tested on its own triangles, and draws marked), full-nohist (every part drawn early tested again each frame), full-nocost (every volume the pyramid lets through tested), full-noclusters (parts drawn whole, no cluster tests); "
+           "vfc-noclusters (vfc drawing parts whole); "
            "settings of queries: approximate thrN (pixel threshold), latency1 (last frame's results), "
            "skipN (history max skip N, 2 per visible), overlap (overlapping batches), smallN (small-feature pixels); "
            "backend: noflush (no glFlush after each batch); "
@@ -179,8 +182,9 @@ bool applyQueriesSetting(const std::string& part, ModeSpec& m) {
 
 Expected<ModeSpec> modeFromName(const std::string& name) {
     ModeSpec m = queriesMode(name);
-    if (name == "vfc") {
+    if (name == "vfc" || name == "vfc-noclusters") {
         m.scheduler.mode = CullMode::Vfc;
+        m.scheduler.useClusters = name == "vfc";
     } else if (name == "simple") {
         m.scheduler.mode = CullMode::Simple;
     } else if (name == "oracle") {
@@ -378,7 +382,8 @@ FalsePositiveCauses BenchRunner::falsePositiveCauses() const {
         switch (t.state) {
             case NodeState::FrustumCulled:
             case NodeState::Occluded:
-            case NodeState::SmallFeature: break;
+            case NodeState::SmallFeature:
+            case NodeState::ClusterCulled: break;
             case NodeState::VisibleQueried: ++c.queried; break;
             case NodeState::VisibleHistory: ++c.history; break;
             case NodeState::VisibleOccupancy: ++c.occupancy; break;

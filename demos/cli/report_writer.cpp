@@ -172,7 +172,8 @@ const char* frameStatsCsvHeader() {
     return "ms_frame,ms_traversal,ms_query,ms_wait,ms_draw,ms_update,queries,queries_occluded,queries_timed_out,"
            "skipped_history,skipped_occupancy,skipped_cost,visible_near,visible_front,frustum_culled,small_feature_culled,"
            "nodes_visited,batches,parts,triangles,query_triangles,draw_queries,draw_queries_occluded,draw_queries_late,"
-           "depth_tests,ms_depth_read,raster_tests,raster_batches,ms_raster,triangle_tests,ms_triangle_test,draw_marks_hidden";
+           "depth_tests,ms_depth_read,raster_tests,raster_batches,ms_raster,triangle_tests,ms_triangle_test,draw_marks_hidden,"
+           "cluster_tests,clusters_culled,cluster_triangles_culled,ms_clusters";
 }
 
 void writeFrameStatsCsv(std::ostream& f, const FrameStats& s) {
@@ -183,7 +184,8 @@ void writeFrameStatsCsv(std::ostream& f, const FrameStats& s) {
       << s.partsDrawn << ',' << s.trianglesDrawn << ',' << s.queryTriangles << ',' << s.drawQueries << ','
       << s.drawQueriesOccluded << ',' << s.drawQueriesLate << ',' << s.depthTests << ',' << s.depthReadMs << ','
       << s.rasterTests << ',' << s.rasterBatches << ',' << s.rasterMs << ',' << s.triangleTests << ','
-      << s.triangleTestMs << ',' << s.drawMarksHidden;
+      << s.triangleTestMs << ',' << s.drawMarksHidden << ',' << s.clusterTests << ',' << s.clustersCulled << ','
+      << s.clusterTrianglesCulled << ',' << s.clusterMs;
 }
 
 Status writeFramesCsv(const BenchResult& r, const fs::path& path) {

@@ -18,7 +18,7 @@ struct Engine::Sink final : PartSink {
     VisibleLists& visible;
     bool marking = false;
     Sink(Engine& engine, VisibleLists& lists) : e(engine), visible(lists) {}
-    void drawPart(NodeRef part, std::uint32_t firstIndex, std::uint32_t indexCount) override {
+    void record(NodeRef part, std::uint32_t firstIndex, std::uint32_t indexCount) {
         const SceneObjects& objs = e.objects_;
         const std::uint32_t object = part.object;
         const ObjectHandle handle = objs.handle(object);
@@ -27,23 +27,42 @@ struct Engine::Sink final : PartSink {
             visible.stamp[object] = visible.serial;
             visible.objects.push_back(handle);
         }
+    }
+    void drawPart(NodeRef part, std::uint32_t firstIndex, std::uint32_t indexCount) override {
+        record(part, firstIndex, indexCount);
         if (e.callback_) {
-            e.callback_(handle, objs.modelOf(object), firstIndex, indexCount, objs.matrix(object));
+            const SceneObjects& objs = e.objects_;
+            e.callback_(objs.handle(part.object), objs.modelOf(part.object), firstIndex, indexCount, objs.matrix(part.object));
             return;
         }
+        const IndexRange range{firstIndex, indexCount};
+        render(part, {&range, 1});
+    }
+    bool drawsRanges() const override { return !e.callback_ && e.renderer_; }
+    bool cullsBackFaces() const override { return !e.callback_ && e.renderer_ && e.renderer_->backFaceCulling(); }
+    void drawPartRanges(NodeRef part, std::span<const IndexRange> ranges) override {
+        assert(drawsRanges() && !ranges.empty());
+        // The part is visible as a whole: the game's lists get its whole range.
+        const LocalBspNode& n = e.objects_.model(e.objects_.modelOf(part.object)).nodes[part.node];
+        record(part, n.firstIndex, n.indexCount);
+        render(part, ranges);
+    }
+    // The part renderer's draw of `ranges` of `part`, marked while marking.
+    void render(NodeRef part, std::span<const IndexRange> ranges) {
+        const SceneObjects& objs = e.objects_;
+        const std::uint32_t object = part.object;
+        const glm::vec3 colour = object < e.hasColour_.size() && e.hasColour_[object] ? e.colour_[object] : colourForId(object);
+        const std::uint32_t markSlot = marking ? e.marks_->nextDrawSlot() : Renderer::kNoMark;
         // An occludee-only object occludes nothing: drawn without depth writes (after
         // everything that occludes, as the scheduler orders it).
         const bool occludee = objs.role(object) == OcclusionRole::OccludeeOnly;
         if (occludee) glDepthMask(GL_FALSE);
-        render({part, firstIndex, indexCount}, marking ? e.marks_->nextDrawSlot() : Renderer::kNoMark);
+        const MeshId mesh = e.meshOfModel_[objs.modelOf(object)];
+        if (ranges.size() == 1)
+            e.renderer_->drawRange(mesh, ranges[0].firstIndex, ranges[0].indexCount, objs.matrix(object), colour, markSlot);
+        else
+            e.renderer_->drawRanges(mesh, ranges, objs.matrix(object), colour, markSlot);
         if (occludee) glDepthMask(GL_TRUE);
-    }
-    void render(const PartRange& p, std::uint32_t markSlot) {
-        const SceneObjects& objs = e.objects_;
-        const std::uint32_t object = p.part.object;
-        const glm::vec3 colour = object < e.hasColour_.size() && e.hasColour_[object] ? e.colour_[object] : colourForId(object);
-        e.renderer_->drawRange(e.meshOfModel_[objs.modelOf(object)], p.firstIndex, p.indexCount, objs.matrix(object),
-                               colour, markSlot);
     }
     bool testsTriangles() const override { return !e.callback_ && e.renderer_ && e.marks_; }
     void beginDrawMarks() override {

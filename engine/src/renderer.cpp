@@ -166,12 +166,7 @@ void Renderer::beginFrame(const FrameView& view) {
     glUniformMatrix4fv(testProgram_.viewProj, 1, GL_FALSE, glm::value_ptr(viewProjRel));
 }
 
-void Renderer::drawRange(MeshId id, std::uint32_t firstIndex, std::uint32_t count, const glm::mat4& model,
-                         const glm::vec3& colour, std::uint32_t markSlot) {
-    assert(id < meshes_.size());
-    const GpuMesh& g = meshes_[id];
-    assert(firstIndex <= g.indexCount && count <= g.indexCount - firstIndex);
-    if (count == 0) return;
+void Renderer::bindDraw(const GpuMesh& g, const glm::mat4& model, const glm::vec3& colour, std::uint32_t markSlot) {
     // Inverse-transpose keeps normals perpendicular under non-uniform scale; done once per
     // draw on the CPU instead of per vertex.
     const glm::mat3 linear(model);
@@ -187,10 +182,38 @@ void Renderer::drawRange(MeshId id, std::uint32_t firstIndex, std::uint32_t coun
     const glm::vec3 c = shading_ == Shading::Vertex ? glm::pow(glm::max(colour, glm::vec3(0.0f)), glm::vec3(1.0f / 1.2f)) : colour;
     glUniform3fv(p.colour, 1, glm::value_ptr(c));
     glBindVertexArray(g.vao);
+}
+
+void Renderer::drawRange(MeshId id, std::uint32_t firstIndex, std::uint32_t count, const glm::mat4& model,
+                         const glm::vec3& colour, std::uint32_t markSlot) {
+    assert(id < meshes_.size());
+    const GpuMesh& g = meshes_[id];
+    assert(firstIndex <= g.indexCount && count <= g.indexCount - firstIndex);
+    if (count == 0) return;
+    bindDraw(g, model, colour, markSlot);
     glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(count), GL_UNSIGNED_INT,
                    reinterpret_cast<const void*>(static_cast<std::uintptr_t>(firstIndex) * sizeof(std::uint32_t)));
     ++stats_.drawCalls;
     stats_.triangles += count / 3;
+}
+
+void Renderer::drawRanges(MeshId id, std::span<const IndexRange> ranges, const glm::mat4& model, const glm::vec3& colour,
+                          std::uint32_t markSlot) {
+    assert(id < meshes_.size());
+    const GpuMesh& g = meshes_[id];
+    if (ranges.empty()) return;
+    multiCounts_.clear();
+    multiOffsets_.clear();
+    for (const IndexRange& r : ranges) {
+        assert(r.firstIndex <= g.indexCount && r.indexCount <= g.indexCount - r.firstIndex);
+        multiCounts_.push_back(static_cast<GLsizei>(r.indexCount));
+        multiOffsets_.push_back(reinterpret_cast<const void*>(static_cast<std::uintptr_t>(r.firstIndex) * sizeof(std::uint32_t)));
+        stats_.triangles += r.indexCount / 3;
+    }
+    bindDraw(g, model, colour, markSlot);
+    glMultiDrawElements(GL_TRIANGLES, multiCounts_.data(), GL_UNSIGNED_INT, multiOffsets_.data(),
+                        static_cast<GLsizei>(ranges.size()));
+    ++stats_.drawCalls;
 }
 
 void Renderer::testRange(MeshId id, std::uint32_t firstIndex, std::uint32_t count, const glm::mat4& model,

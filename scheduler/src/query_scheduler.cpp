@@ -42,6 +42,7 @@ const char* toString(NodeState s) {
         case NodeState::VisibleVfc: return "visible_vfc";
         case NodeState::VisibleCheaper: return "visible_cheaper";
         case NodeState::VisibleOccluder: return "visible_occluder";
+        case NodeState::ClusterCulled: return "cluster_culled";
     }
     return "?";
 }
@@ -82,6 +83,7 @@ FrameStats QueryScheduler::cullFrame(const TwoLevelTree& tree, const FrameView& 
     backend_ = &backend;
     sink_ = &sink;
     marking_ = false;
+    clusterPyramid_ = false;
     camera_ = camera;
     // Camera-relative (eye at the origin, set up in double): precise at any distance from
     // the world origin, like the renderer's and the query backend's transforms.
@@ -300,23 +302,45 @@ QueryVolume objectNodeVolume(const SceneObjects& objs, NodeRef ref, VolumeChoice
 
 void QueryScheduler::drawNode(NodeRef ref, bool untested) {
     const SceneObjects& objs = tree_->objects();
-    const LocalBspNode& n = objs.model(objs.modelOf(ref.object)).nodes[ref.node];
+    const LocalBsp& model = objs.model(objs.modelOf(ref.object));
+    const LocalBspNode& n = model.nodes[ref.node];
+    const bool clustered = cullClusters(ref, model, n);
+    if (clustered && clusterRanges_.empty()) {
+        // No cluster of it can show a pixel: its decision, traced just before, becomes this.
+        if (trace_) {
+            if (!trace_->empty() && trace_->back().ref == ref)
+                trace_->back().state = NodeState::ClusterCulled;
+            else
+                trace(ref, tree_->worldBox(ref), NodeState::ClusterCulled);
+        }
+        return;
+    }
     const auto t0 = Clock::now();
+    auto draw = [&] {
+        if (clustered)
+            sink_->drawPartRanges(ref, clusterRanges_);
+        else
+            sink_->drawPart(ref, n.firstIndex, n.indexCount);
+    };
     if (untested && params_.mode == CullMode::Queries && params_.useDrawQueries) {
         const QueryId id = backend_->beginDrawQuery();
-        sink_->drawPart(ref, n.firstIndex, n.indexCount);
+        draw();
         if (id != kNoQuery) {
             backend_->endDrawQuery(id);
             drawQueries_.push_back(pendingOf(ref, id, {}, false));
             ++stats_->drawQueries;
         }
     } else {
-        sink_->drawPart(ref, n.firstIndex, n.indexCount);
+        draw();
         if (marking_) markedDraws_.push_back(ref);  // the sink marks its draws in this order
     }
     stats_->drawMs += msSince(t0);
     ++stats_->partsDrawn;
-    stats_->trianglesDrawn += n.indexCount / 3;
+    if (!clustered) {
+        stats_->trianglesDrawn += n.indexCount / 3;
+    } else {
+        for (const IndexRange& r : clusterRanges_) stats_->trianglesDrawn += r.indexCount / 3;
+    }
     if (params_.mode == CullMode::Queries && params_.useOccupancyAccept) {
         ScreenRect r;
         projectRect(tree_->worldBox(ref), r);

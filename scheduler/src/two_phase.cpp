@@ -105,6 +105,7 @@ void QueryScheduler::runTwoPhase() {
         int w = 0, hgt = 0;
         haveDepth = backend_->readDepth(depth_, w, hgt) && w == width_ && hgt == height_;
         if (haveDepth) pyramid_.build(depth_, w, hgt);
+        clusterPyramid_ = haveDepth;  // the late pass's draws test their clusters against it too
         stats_->depthReadMs += msSince(t0);
     }
 

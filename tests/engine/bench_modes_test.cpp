@@ -27,6 +27,11 @@ TEST(BenchModes, AblationsOfFullAndTheirVolumes) {
     EXPECT_FALSE(modeFromName("full-nocost")->scheduler.useCostModel);
     EXPECT_FALSE(modeFromName("full")->scheduler.useTriangleTests);
     EXPECT_TRUE(modeFromName("full-tri")->scheduler.useTriangleTests);
+    EXPECT_TRUE(modeFromName("full")->scheduler.useClusters);
+    EXPECT_FALSE(modeFromName("full-noclusters")->scheduler.useClusters);
+    EXPECT_TRUE(modeFromName("vfc")->scheduler.useClusters);
+    EXPECT_FALSE(modeFromName("vfc-noclusters")->scheduler.useClusters);
+    EXPECT_EQ(modeFromName("vfc-noclusters")->scheduler.mode, CullMode::Vfc);
     const ModeSpec k = modeFromName("full+kdop26").take();
     EXPECT_EQ(k.scheduler.mode, CullMode::TwoPhase);
     EXPECT_EQ(k.scheduler.volume, VolumeChoice::Kdop26);

@@ -19,7 +19,7 @@
 
 namespace dyncull {
 
-inline constexpr std::uint32_t kSceneCacheVersion = 2;  // 2: face mode per model, leaves in cache order
+inline constexpr std::uint32_t kSceneCacheVersion = 3;  // 2: face mode per model, leaves in cache order; 3: leaves in meshlet order
 inline constexpr std::size_t kSceneCacheHeaderSize = 40;
 
 /// Writes `scene` to `path` (via a temporary file renamed into place, so readers never see

@@ -10,6 +10,7 @@
 #include <limits>
 #include <vector>
 
+#include "dyncull/bsp/leaf_clusters.hpp"
 #include "dyncull/bsp/node_volumes.hpp"
 #include "dyncull/objects/aabb.hpp"
 #include "dyncull/objects/error.hpp"
@@ -108,6 +109,9 @@ struct LocalBsp {
     /// Each node's query volumes (object space), indexed like `nodes`. Filled by
     /// buildLocalBsp; a hand-made or cache-loaded LocalBsp gets them in SceneObjects::addModel.
     NodeVolumes volumes;
+    /// Each leaf's clusters (object space). Filled by buildLocalBsp; a hand-made or
+    /// cache-loaded LocalBsp gets them in SceneObjects::addModel, cut from its index order.
+    LeafClusters clusters;
     /// How the renderer and the ground truth draw `mesh` (see FacePolicy).
     FaceMode faces = FaceMode::TwoSided;
     /// Triangles a draw of the whole model costs when `mesh` only stands for it (a bounds
@@ -147,8 +151,10 @@ Expected<LocalBsp> buildBoundsModel(const Aabb& bounds, std::uint32_t triangles)
 Expected<std::vector<float>> carryAttributes(const LocalBsp& bsp, std::span<const float> attributes,
                                              std::uint32_t components);
 
-/// Reorders the triangles inside each leaf of `bsp` for the post-transform vertex cache and
-/// then for overdraw (meshoptimizer); every node keeps its index range and triangle set.
+/// Reorders the triangles inside each leaf of `bsp` for the post-transform vertex cache, then
+/// for overdraw, then into meshoptimizer's meshlets (each again in vertex-cache order), so
+/// that clustersOf cuts the leaf into tight clusters; every node keeps its index range and
+/// triangle set.
 void optimizeLeafOrder(LocalBsp& bsp);
 
 }  // namespace dyncull

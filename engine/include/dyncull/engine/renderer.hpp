@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -17,6 +18,7 @@
 #include "dyncull/objects/error.hpp"
 #include "dyncull/objects/mesh.hpp"
 #include "dyncull/objects/surface_orientation.hpp"
+#include "dyncull/scheduler/query_backend.hpp"
 
 namespace dyncull {
 
@@ -81,6 +83,10 @@ public:
     /// occlusion test of the range's own triangles. The image is the same either way.
     void drawRange(MeshId id, std::uint32_t firstIndex, std::uint32_t indexCount, const glm::mat4& model,
                    const glm::vec3& colour, std::uint32_t markSlot = kNoMark);
+    /// drawRange of several ranges of mesh `id` at once (one glMultiDrawElements): a part
+    /// drawn as its surviving clusters. Counted as one draw call.
+    void drawRanges(MeshId id, std::span<const IndexRange> ranges, const glm::mat4& model, const glm::vec3& colour,
+                    std::uint32_t markSlot = kNoMark);
     /// The exact occlusion test of a range's own triangles: drawRange's fragments (the same
     /// positions, by an invariant expression, and the same face culling), depth-tested
     /// with the current depth function, mark `markSlot` as drawRange's marks do. Only the
@@ -106,6 +112,8 @@ public:
     Shading shading() const { return shading_; }
     /// false draws every mesh two-sided whatever its FaceMode (to measure what culling saves).
     void setBackFaceCulling(bool honour) { cullBackFaces_ = honour; }
+    /// Whether meshes uploaded with FaceMode::CullBack are drawn with back faces culled.
+    bool backFaceCulling() const { return cullBackFaces_; }
     /// true runs only the vertex stage (GL_RASTERIZER_DISCARD from beginFrame to endFrame),
     /// to measure the vertex share of a frame; nothing is drawn. With `vfc` only: occlusion
     /// tests rasterise nothing either, so they would cull everything.
@@ -147,6 +155,10 @@ private:
     bool cullEnabled_ = false, frontCcw_ = true;  // GL culling state as set in this frame (engine/src/face_culling.hpp)
     glm::mat4 viewProj_{1.0f};  // world space (box overlays); parts are drawn camera-relative
     Camera camera_;             // of the current frame, for camera-relative model matrices
+    std::vector<int> multiCounts_;            // drawRanges' arguments, reused
+    std::vector<const void*> multiOffsets_;
+    /// Binds mesh `g`'s program, uniforms, face culling and vertex array for a draw.
+    void bindDraw(const GpuMesh& g, const glm::mat4& model, const glm::vec3& colour, std::uint32_t markSlot);
     RenderStats stats_;
 };
 

@@ -21,6 +21,10 @@ struct FrameStats {
     std::uint32_t triangleTests = 0;  ///< two-phase: parts tested on their own triangles (PartSink::testParts)
     double triangleTestMs = 0.0;      ///< two-phase: drawing and waiting for the triangle tests, and reading the draw marks
     std::uint32_t drawMarksHidden = 0;  ///< two-phase: parts drawn whose draw showed no sample
+    std::uint32_t clusterTests = 0;     ///< clusters of drawn parts tested (SchedulerParams::useClusters)
+    std::uint32_t clustersCulled = 0;   ///< of those, left undrawn: facing away, outside the frustum or behind the pyramid
+    std::uint64_t clusterTrianglesCulled = 0;  ///< their triangles (not in trianglesDrawn)
+    double clusterMs = 0.0;             ///< CPU in the cluster tests
     std::uint64_t queryTriangles = 0;   ///< triangles of the query volumes drawn (12 per box)
     std::uint32_t queriesOccluded = 0;  ///< answered "occluded"
     std::uint32_t queriesTimedOut = 0;  ///< never answered within the bound; counted visible
@@ -37,7 +41,9 @@ struct FrameStats {
     std::uint32_t smallFeatureCulled = 0;  ///< approximate small-feature setting
     std::uint32_t nodesVisited = 0;
     std::uint32_t batches = 0;
-    std::uint32_t partsDrawn = 0;  ///< local-BSP leaves (object parts) drawn
+    /// Local-BSP leaves (object parts) drawn, whole or as the clusters that survived; a part
+    /// none of whose clusters survived is not drawn and not counted.
+    std::uint32_t partsDrawn = 0;
     std::uint64_t trianglesDrawn = 0;
 };
 

@@ -141,6 +141,12 @@ struct PartRange {
     std::uint32_t indexCount = 0;
 };
 
+/// A range [firstIndex, firstIndex + indexCount) of a model's split mesh.
+struct IndexRange {
+    std::uint32_t firstIndex = 0;
+    std::uint32_t indexCount = 0;
+};
+
 /// What the scheduler calls to draw an object part. A sink that draws the parts itself
 /// (the engine's part renderer) may also test them on their own triangles, the strictest
 /// conservative test there is: a part none of whose fragments passes the depth test now
@@ -149,6 +155,20 @@ class PartSink {
 public:
     virtual ~PartSink() = default;
     virtual void drawPart(NodeRef part, std::uint32_t firstIndex, std::uint32_t indexCount) = 0;
+
+    /// Whether drawPartRanges draws several ranges as cheaply as one (a multi-draw), so the
+    /// scheduler may draw a part as its surviving clusters (false: the default, e.g. a
+    /// game's own draws, which get whole parts).
+    virtual bool drawsRanges() const { return false; }
+    /// Draws part `part` as `ranges`: ascending, disjoint, non-empty, all inside the part's
+    /// own range (its clusters that survived the scheduler's tests). The part counts as
+    /// drawn once, with draw marks as drawPart's.
+    virtual void drawPartRanges(NodeRef part, std::span<const IndexRange> ranges) {
+        for (const IndexRange& r : ranges) drawPart(part, r.firstIndex, r.indexCount);
+    }
+    /// Whether models with FaceMode::CullBack are drawn with their back faces culled now, so
+    /// a cluster facing away from the eye shows nothing (false: the default).
+    virtual bool cullsBackFaces() const { return false; }
 
     /// Whether the three calls below work (false: the default, e.g. a game's own draws).
     virtual bool testsTriangles() const { return false; }

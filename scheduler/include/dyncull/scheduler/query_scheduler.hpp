@@ -122,6 +122,15 @@ struct SchedulerParams {
     /// loses there (docs/BENCHMARKS.md); it pays where shading, not triangle set-up, is
     /// what drawing costs.
     bool useTriangleTests = false;
+    /// Every mode, where the PartSink draws index ranges (PartSink::drawsRanges: the
+    /// engine's part renderer): a part is drawn as those of its clusters (leaf_clusters.hpp)
+    /// that survive three tests too cheap to need a query, in one multi-draw: facing away
+    /// from the eye (the normal cone, for models whose back faces the sink culls), outside
+    /// the frustum (for parts crossing it), and, in TwoPhase's late pass, behind the depth
+    /// pyramid. Conservative like the part tests: a culled cluster shows no pixel. The cost
+    /// model weighs `clusterTestNs` per cluster against the drawing it saves, at each
+    /// model's measured rate. Off: whole parts (an ablation).
+    bool useClusters = true;
 
     /// TwoPhase's cost model: a volume the pyramid cannot reject is tested only where the
     /// test is expected to pay. Its cost is `testNsPerVolume` plus `testNsPerPixel` per
@@ -139,13 +148,15 @@ struct SchedulerParams {
     /// A triangle test (useTriangleTests) costs `triangleTestNsPerPart` plus
     /// `triangleTestNsPerTriangle` per triangle, and is weighed the same way; the default is
     /// 1.3x drawNsPerTriangle, as measured (`bench_draw_speed`: test-hidden against parts),
-    /// so on llvmpipe only the exploring eighth of the parts is tested.
+    /// so on llvmpipe only the exploring eighth of the parts is tested. A cluster's tests
+    /// (useClusters) cost `clusterTestNs` of CPU (`bench_volume_tests`).
     struct TestCosts {
         double drawNsPerTriangle = 53.0;
         double testNsPerVolume = 5000.0;
         double testNsPerPixel = 1.5;
         double triangleTestNsPerPart = 0.0;
         double triangleTestNsPerTriangle = 69.0;
+        double clusterTestNs = 150.0;
         double depthReadNs = 400000.0;
         std::uint32_t probeFrames = 16;
     };
@@ -168,6 +179,7 @@ enum class NodeState : std::uint8_t {
     VisibleVfc,         ///< vfc mode: in the frustum
     VisibleCheaper,     ///< two-phase: drawn untested, since the cost model expects the test to cost more than it saves
     VisibleOccluder,    ///< an occluder-only object (OcclusionRole): drawn whole and untested whenever in the frustum
+    ClusterCulled,      ///< decided visible, but none of its clusters survived their tests (SchedulerParams::useClusters): not drawn
 };
 const char* toString(NodeState s);
 
@@ -327,6 +339,16 @@ private:
     bool worthTesting(NodeRef ref, const ScreenRect& rect, double occludedRate);
     /// True for the new parts tested this frame whatever the cost model expects.
     bool exploring(NodeRef ref) const;
+    // useClusters (cluster_culling.cpp): the ranges of the part being drawn, whether the
+    // pyramid holds this frame's early depth, and per model the measured fraction of
+    // tested triangles that the cluster tests culled (a moving average).
+    std::vector<IndexRange> clusterRanges_;
+    bool clusterPyramid_ = false;
+    std::vector<double> clusterCulledRate_;
+    /// Tests the clusters of part `ref` (node `n` of `model`) where they may pay, leaving
+    /// the survivors in clusterRanges_ (adjacent ones merged); false if the part is to be
+    /// drawn whole.
+    bool cullClusters(NodeRef ref, const LocalBsp& model, const LocalBspNode& n);
     std::vector<QueryVolume> rasterVolumes_;
     std::vector<QueryResult> rasterAnswers_;
     /// One batched raster test of `parts`' volumes, answers in rasterAnswers_ (all Visible
