@@ -154,7 +154,7 @@ private:
 // point, read back at the end (the answers in hand).
 class PartLoop {
 public:
-    enum class Kind { Draw, DrawMarked, TestVisible, TestHidden };
+    enum class Kind { Draw, DrawClusters, DrawMarked, TestVisible, TestHidden };
     PartLoop() { glCreateBuffers(1, &marks_); }
     ~PartLoop() { glDeleteBuffers(1, &marks_); }
 
@@ -186,7 +186,7 @@ public:
         std::uint32_t slots = 0;
         for (const auto& [distance, o] : order_)
             for (const LocalBspNode& n : objs.model(objs.modelOf(o)).nodes) slots += n.isLeaf() ? 1u : 0u;
-        if (kind != Kind::Draw) {
+        if (kind != Kind::Draw && kind != Kind::DrawClusters) {
             glNamedBufferData(marks_, std::max<GLsizeiptr>(4, GLsizeiptr{4} * slots), nullptr, GL_STREAM_READ);
             const std::uint32_t zero = 0;
             glClearNamedBufferData(marks_, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
@@ -196,9 +196,18 @@ public:
         std::uint32_t slot = 0;
         for (const auto& [distance, o] : order_) {
             const MeshId mesh = engine.meshOf(objs.modelOf(o));
-            for (const LocalBspNode& n : objs.model(objs.modelOf(o)).nodes) {
+            const LocalBsp& model = objs.model(objs.modelOf(o));
+            for (std::uint32_t i = 0; i < model.nodes.size(); ++i) {
+                const LocalBspNode& n = model.nodes[i];
                 if (!n.isLeaf()) continue;
-                if (test)
+                if (kind == Kind::DrawClusters) {
+                    if (slot == 0) ranges = parts = 0;
+                    ++parts;
+                    ranges_.clear();
+                    for (const LeafCluster& c : model.clusters.ofSubtree(i, 1)) ranges_.push_back({c.firstIndex, c.indexCount});
+                    r.drawRanges(mesh, ranges_, objs.matrix(o), colourForId(o));
+                    ranges += ranges_.size();
+                } else if (test)
                     r.testRange(mesh, n.firstIndex, n.indexCount, objs.matrix(o), slot);
                 else
                     r.drawRange(mesh, n.firstIndex, n.indexCount, objs.matrix(o), colourForId(o),
@@ -212,7 +221,7 @@ public:
             glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
             glDepthMask(GL_TRUE);
         }
-        if (kind != Kind::Draw) {
+        if (kind != Kind::Draw && kind != Kind::DrawClusters) {
             answers_.resize(slots);
             glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
             glGetNamedBufferSubData(marks_, 0, GLsizeiptr{4} * slots, answers_.data());
@@ -227,6 +236,10 @@ private:
     GLuint marks_ = 0;
     std::vector<std::pair<float, std::uint32_t>> order_;
     std::vector<std::uint32_t> answers_;
+    std::vector<IndexRange> ranges_;
+
+public:
+    std::uint64_t ranges = 0, parts = 0;  // of the last DrawClusters frame
 };
 
 struct Variant {
@@ -310,6 +323,9 @@ int main(int argc, char** argv) {
     BunnySwarmOptions loadOrder = o;
     loadOrder.optimizeOrder = false;
     Swarm unordered = makeSwarm(**ctx, loadOrder);
+    BunnySwarmOptions cacheOrder = o;
+    cacheOrder.clusterOrder = false;
+    Swarm noMeshlets = makeSwarm(**ctx, cacheOrder);
     const bool culls = tuned.engine->model(0).faces == FaceMode::CullBack;
     std::unique_ptr<Swarm> forced;  // FacePolicy::CullBack when Auto keeps the mesh two-sided
     if (!culls) {
@@ -331,8 +347,11 @@ int main(int argc, char** argv) {
             return t;
         };
     };
-    auto vfcFrame = [](Swarm& s, Shading shading, bool cull, bool discard) {
-        return [&s, shading, cull, discard]() -> std::uint64_t {
+    auto vfcFrame = [](Swarm& s, Shading shading, bool cull, bool discard, bool clusters = true) {
+        return [&s, shading, cull, discard, clusters]() -> std::uint64_t {
+            SchedulerParams p = s.vfc.params();
+            p.useClusters = clusters;
+            s.vfc.setParams(p);
             s.engine->renderer().setShading(shading);
             s.engine->renderer().setBackFaceCulling(cull);
             s.engine->renderer().setRasteriserDiscard(discard);
@@ -361,6 +380,10 @@ int main(int argc, char** argv) {
                         {}, 0, {}});
     variants.push_back({"vfc", "dyncull vfc: per-vertex lighting, faces as decided, parts in cache order",
                         vfcFrame(tuned, Shading::Vertex, true, false), {}, 0, {}});
+    variants.push_back({"vfc-noclusters", "vfc drawing whole parts (no cluster tests)",
+                        vfcFrame(tuned, Shading::Vertex, true, false, false), {}, 0, {}});
+    variants.push_back({"vfc-cache-order", "vfc with the parts in cache and overdraw order, not meshlets (clusters cut from it)",
+                        vfcFrame(noMeshlets, Shading::Vertex, true, false), {}, 0, {}});
     variants.push_back({"vfc-discard", "vfc with rasteriser discard: traversal, draws, vertex work",
                         vfcFrame(tuned, Shading::Vertex, true, true), {}, 0, {}});
     variants.push_back({"vfc-pixel", "vfc with per-pixel lighting", vfcFrame(tuned, Shading::Pixel, true, false), {}, 0, {}});
@@ -376,21 +399,25 @@ int main(int argc, char** argv) {
     PartLoop parts;
     auto partFrame = [&](PartLoop::Kind kind) { return finished([&parts, &tuned, kind] { return parts.run(*tuned.engine, kind); }); };
     variants.push_back({"parts", "every part in view drawn alone, nearest bunny first, no traversal", partFrame(PartLoop::Kind::Draw), {}, 0, {}});
+    variants.push_back({"parts-clusters", "parts, each drawn as its clusters' ranges in one multi-draw (nothing culled): the cost of a range",
+                        partFrame(PartLoop::Kind::DrawClusters), {}, 0, {}});
+    variants.push_back({"parts-cache-order", "parts, in cache and overdraw order instead of meshlets",
+                        finished([&parts, &noMeshlets] { return parts.run(*noMeshlets.engine, PartLoop::Kind::Draw); }), {}, 0, {}});
     variants.push_back({"parts-marked", "parts, each draw marking whether it showed a sample (two-phase's draw marks)",
                         partFrame(PartLoop::Kind::DrawMarked), {}, 0, {}});
     variants.push_back({"test-visible", "every part tested on its own triangles, every fragment passing",
                         partFrame(PartLoop::Kind::TestVisible), {}, 0, {}});
     variants.push_back({"test-hidden", "every part tested on its own triangles behind a wall (every fragment fails)",
                         partFrame(PartLoop::Kind::TestHidden), {}, 0, {}});
-    variants.push_back({"vfc-before", "the renderer before issue 21: per-pixel, two-sided, load order",
-                        vfcFrame(unordered, Shading::Pixel, false, false), {}, 0, {}});
+    variants.push_back({"vfc-before", "the renderer before issue 21: per-pixel, two-sided, load order, whole parts",
+                        vfcFrame(unordered, Shading::Pixel, false, false, false), {}, 0, {}});
 
     if (!only.empty()) {
         const std::string list = "," + only + ",";
         std::erase_if(variants, [&](const Variant& v) { return list.find("," + v.name + ",") == std::string::npos; });
         if (variants.empty()) fail("--only: no such variant in '" + only + "'");
     }
-    std::vector<Swarm*> swarms{&tuned, &unordered};
+    std::vector<Swarm*> swarms{&tuned, &unordered, &noMeshlets};
     if (forced) swarms.push_back(forced.get());
     const float aspect = static_cast<float>(width) / static_cast<float>(height);
     // Frame -1 is a warm-up: llvmpipe compiles shader and state variants on first use,
@@ -440,6 +467,15 @@ int main(int argc, char** argv) {
     if (Status s = closeChecked(csv, csvPath); !s) fail(s.message());
     // Culling back faces of a closed surface and reordering triangles inside a part must
     // not change the picture (depth ties aside); per-pixel lighting changes it slightly.
+    // What one more range of a multi-draw costs: drawing every part as its clusters'
+    // ranges against drawing it as one range, the same triangles.
+    const auto named = [&](const char* n) {
+        return std::find_if(variants.begin(), variants.end(), [&](const Variant& v) { return v.name == n; });
+    };
+    if (named("parts") != variants.end() && named("parts-clusters") != variants.end() && parts.ranges > parts.parts)
+        std::printf("a range of a multi-draw costs %.2f us (parts-clusters against parts, %llu ranges for %llu parts)\n",
+                    1000.0 * (median(named("parts-clusters")->ms) - median(named("parts")->ms)) / double(parts.ranges - parts.parts),
+                    static_cast<unsigned long long>(parts.ranges), static_cast<unsigned long long>(parts.parts));
     const auto vfc = std::find_if(variants.begin(), variants.end(), [](const Variant& v) { return v.name == "vfc"; });
     const Image& ref = vfc != variants.end() ? vfc->first : variants[0].first;
     for (const Variant& v : variants)

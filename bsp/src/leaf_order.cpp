@@ -47,7 +47,7 @@ void orderAsMeshlets(std::vector<std::uint32_t>& local, const std::vector<glm::v
 
 }  // namespace
 
-void optimizeLeafOrder(LocalBsp& bsp) {
+void optimizeLeafOrder(LocalBsp& bsp, bool meshlets) {
     Mesh& mesh = bsp.mesh;
     // Per leaf the vertices are renumbered densely first, so each call costs the leaf's
     // size rather than the whole mesh's vertex count (a mesh may have thousands of leaves).
@@ -74,7 +74,7 @@ void optimizeLeafOrder(LocalBsp& bsp) {
         meshopt_optimizeVertexCache(ordered.data(), local.data(), count, globalOf.size());
         meshopt_optimizeOverdraw(local.data(), ordered.data(), count, &positions[0].x, positions.size(),
                                  sizeof(glm::vec3), kOverdrawThreshold);
-        orderAsMeshlets(local, positions);
+        if (meshlets) orderAsMeshlets(local, positions);
         for (std::size_t i = 0; i < count; ++i) mesh.indices[first + i] = globalOf[local[i]];
         for (const std::uint32_t v : globalOf) localOf[v] = kInvalidIndex;
     }

@@ -190,7 +190,7 @@ Expected<LocalBsp> buildLocalBsp(const Mesh& mesh, const LocalBspParams& params)
         Builder builder(params, bsp);
         builder.run(input);
     }
-    if (params.optimizeOrder) optimizeLeafOrder(bsp);
+    if (params.optimizeOrder) optimizeLeafOrder(bsp, params.clusterOrder);
     bsp.stats.trianglesAfter = bsp.mesh.triangleCount();
     bsp.volumes = buildNodeVolumes(bsp.mesh, bsp.nodes);
     bsp.clusters = clustersOf(bsp.mesh, bsp.nodes);

@@ -50,8 +50,8 @@ bool QueryScheduler::cullClusters(NodeRef ref, const LocalBsp& model, const Loca
     const bool ortho = camera_.orthographic();
     const glm::dvec3 eye = glm::dvec3(toObject * glm::dvec4(glm::dvec3(camera_.position), 1.0));
     const glm::dvec3 along = glm::dvec3(toObject * glm::dvec4(glm::dvec3(camera_.forward()), 0.0));
-    std::uint64_t culledTriangles = 0;
-    std::uint32_t culledClusters = 0;
+    std::uint64_t culledTriangles = 0, gapTriangles = 0;
+    std::uint32_t culledClusters = 0, gapClusters = 0;
     for (const LeafCluster& c : clusters) {
         bool culled = cones && (ortho ? c.backFacingAlong(along) : c.backFacingFrom(eye));
         if (!culled && (frustum || pyramid)) {
@@ -66,15 +66,25 @@ bool QueryScheduler::cullClusters(NodeRef ref, const LocalBsp& model, const Loca
             }
         }
         if (culled) {
-            ++culledClusters;
-            culledTriangles += c.indexCount / 3;
+            ++gapClusters;
+            gapTriangles += c.indexCount / 3;
             continue;
         }
-        if (!clusterRanges_.empty() && clusterRanges_.back().firstIndex + clusterRanges_.back().indexCount == c.firstIndex)
-            clusterRanges_.back().indexCount += c.indexCount;
-        else
+        // A gap of culled clusters between two drawn ones costs one more range of the
+        // multi-draw: skipped only where it saves more drawing than a range costs.
+        IndexRange* last = clusterRanges_.empty() ? nullptr : &clusterRanges_.back();
+        if (last && double(gapTriangles) * params_.costs.drawNsPerTriangle < params_.costs.drawNsPerRange) {
+            last->indexCount = c.firstIndex + c.indexCount - last->firstIndex;
+        } else {
             clusterRanges_.push_back({c.firstIndex, c.indexCount});
+            culledClusters += gapClusters;
+            culledTriangles += gapTriangles;
+        }
+        gapClusters = 0;
+        gapTriangles = 0;
     }
+    culledClusters += gapClusters;  // after the last drawn one: costs no range
+    culledTriangles += gapTriangles;
     stats_->clusterTests += static_cast<std::uint32_t>(clusters.size());
     stats_->clustersCulled += culledClusters;
     stats_->clusterTrianglesCulled += culledTriangles;

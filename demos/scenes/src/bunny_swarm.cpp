@@ -64,6 +64,7 @@ public:
         bspParams.maxLeafTriangles = o_.leafTriangles;
         bspParams.faces = o_.faces;
         bspParams.optimizeOrder = o_.optimizeOrder;
+        bspParams.clusterOrder = o_.clusterOrder;
         auto model = engine.addModel(mesh, bspParams);
         if (!model) return Error{model.error().message};
         const LocalBsp& bsp = engine.model(*model);

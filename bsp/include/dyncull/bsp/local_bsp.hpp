@@ -54,6 +54,10 @@ struct LocalBspParams {
     /// Reorder the triangles inside each leaf for the vertex cache and for overdraw
     /// (optimizeLeafOrder); false keeps them in input order (to measure what it gives).
     bool optimizeOrder = true;
+    /// With optimizeOrder: the last reordering gathers each leaf's triangles into
+    /// meshoptimizer's meshlets, so its clusters are tight; false stops at the cache and
+    /// overdraw order (clusters are then cut from it, to measure what the meshlets give).
+    bool clusterOrder = true;
 };
 
 /// One node. Nodes are stored depth-first (a node's subtree is the contiguous index range
@@ -152,9 +156,9 @@ Expected<std::vector<float>> carryAttributes(const LocalBsp& bsp, std::span<cons
                                              std::uint32_t components);
 
 /// Reorders the triangles inside each leaf of `bsp` for the post-transform vertex cache, then
-/// for overdraw, then into meshoptimizer's meshlets (each again in vertex-cache order), so
-/// that clustersOf cuts the leaf into tight clusters; every node keeps its index range and
-/// triangle set.
-void optimizeLeafOrder(LocalBsp& bsp);
+/// for overdraw, then (with `meshlets`) into meshoptimizer's meshlets, each again in
+/// vertex-cache order, so that clustersOf cuts the leaf into tight clusters; every node
+/// keeps its index range and triangle set.
+void optimizeLeafOrder(LocalBsp& bsp, bool meshlets = true);
 
 }  // namespace dyncull

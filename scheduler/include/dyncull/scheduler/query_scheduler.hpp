@@ -149,14 +149,18 @@ struct SchedulerParams {
     /// `triangleTestNsPerTriangle` per triangle, and is weighed the same way; the default is
     /// 1.3x drawNsPerTriangle, as measured (`bench_draw_speed`: test-hidden against parts),
     /// so on llvmpipe only the exploring eighth of the parts is tested. A cluster's tests
-    /// (useClusters) cost `clusterTestNs` of CPU (`bench_volume_tests`).
+    /// (useClusters) cost `clusterTestNs` of CPU (the swarm's `ms_clusters` over
+    /// `cluster_tests`), and a gap of culled clusters between drawn ones is skipped only if
+    /// its drawing costs more than `drawNsPerRange`, one more range of the multi-draw
+    /// (`bench_draw_speed`: parts-clusters against parts; nothing measurable on llvmpipe).
     struct TestCosts {
         double drawNsPerTriangle = 53.0;
         double testNsPerVolume = 5000.0;
         double testNsPerPixel = 1.5;
         double triangleTestNsPerPart = 0.0;
         double triangleTestNsPerTriangle = 69.0;
-        double clusterTestNs = 150.0;
+        double clusterTestNs = 90.0;
+        double drawNsPerRange = 0.0;
         double depthReadNs = 400000.0;
         std::uint32_t probeFrames = 16;
     };

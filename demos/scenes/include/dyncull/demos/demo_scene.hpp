@@ -60,6 +60,8 @@ struct BunnySwarmOptions {
     bool keepHoles = false;
     /// Triangles reordered inside each part for the vertex cache and overdraw (LocalBspParams::optimizeOrder).
     bool optimizeOrder = LocalBspParams{}.optimizeOrder;
+    /// The cache order ends in meshlets (LocalBspParams::clusterOrder).
+    bool clusterOrder = LocalBspParams{}.clusterOrder;
 };
 
 /// Where the bunny mesh comes from, in order: `meshPath`; `<assets>/bun_zipper.ply` (the
