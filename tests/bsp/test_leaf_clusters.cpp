@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <numbers>
 #include <random>
 #include <set>
 
@@ -17,19 +16,7 @@
 namespace dyncull {
 namespace {
 
-Mesh sphereMesh(int slices, int stacks) {
-    Mesh m;
-    m.name = "sphere";
-    for (int j = 0; j <= stacks; ++j) {
-        const float phi = std::numbers::pi_v<float> * float(j) / float(stacks);
-        for (int i = 0; i < slices; ++i) {
-            const float theta = 2.0f * std::numbers::pi_v<float> * float(i) / float(slices);
-            m.positions.push_back({std::sin(phi) * std::cos(theta), std::cos(phi), std::sin(phi) * std::sin(theta)});
-        }
-    }
-    test::appendSphereGridTriangles(m, slices, stacks);
-    return m;
-}
+Mesh sphereMesh(int slices, int stacks) { return test::sphereGridMesh(slices, stacks); }
 
 LocalBsp build(const Mesh& mesh, std::uint32_t leafTriangles) {
     LocalBspParams p;

@@ -18,18 +18,7 @@ namespace dyncull {
 namespace {
 
 Mesh sphereMesh(int slices, int stacks, float radius = 1.0f, glm::vec3 centre = glm::vec3(0.0f)) {
-    Mesh m;
-    m.name = "sphere";
-    for (int j = 0; j <= stacks; ++j) {
-        const float phi = std::numbers::pi_v<float> * float(j) / float(stacks);
-        for (int i = 0; i < slices; ++i) {
-            const float theta = 2.0f * std::numbers::pi_v<float> * float(i) / float(slices);
-            m.positions.push_back(centre + radius * glm::vec3(std::sin(phi) * std::cos(theta), std::cos(phi),
-                                                              std::sin(phi) * std::sin(theta)));
-        }
-    }
-    test::appendSphereGridTriangles(m, slices, stacks);
-    return m;
+    return test::sphereGridMesh(slices, stacks, radius, centre);
 }
 
 // A flat n x n grid of quads in the z = 0 plane.

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "dyncull/engine/engine.hpp"
+#include "dyncull/measure/image_compare.hpp"
 #include "engine/gl_test_util.hpp"
 #include "engine/procedural_meshes.hpp"
 #include "objects/transform_at.hpp"
@@ -20,11 +21,9 @@ namespace {
 using test::at;
 
 std::uint64_t differingPixels(const Image& a, const Image& b) {
-    EXPECT_EQ(a.rgba.size(), b.rgba.size());
-    std::uint64_t n = 0;
-    for (std::size_t i = 0; i + 3 < a.rgba.size() && i + 3 < b.rgba.size(); i += 4)
-        n += a.rgba[i] != b.rgba[i] || a.rgba[i + 1] != b.rgba[i + 1] || a.rgba[i + 2] != b.rgba[i + 2];
-    return n;
+    auto d = compareImages(a, b);
+    EXPECT_TRUE(d.ok()) << d.error().message;
+    return d.ok() ? d->differingPixels : ~std::uint64_t{0};
 }
 
 SchedulerParams paramsOf(CullMode mode, bool clusters) {

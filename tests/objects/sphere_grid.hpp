@@ -1,7 +1,9 @@
 // Triangles of a latitude-longitude grid, shared by the tests that build sphere-like meshes.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
+#include <numbers>
 
 #include "dyncull/objects/mesh.hpp"
 
@@ -17,6 +19,23 @@ inline void appendSphereGridTriangles(Mesh& m, int slices, int stacks) {
             if (j > 0) m.indices.insert(m.indices.end(), {a, b, c});
             if (j + 1 < stacks) m.indices.insert(m.indices.end(), {b, d, c});
         }
+}
+
+/// A UV sphere of `slices` x (stacks + 1) positions (poles included once per slice) and
+/// appendSphereGridTriangles' triangles; no normals.
+inline Mesh sphereGridMesh(int slices, int stacks, float radius = 1.0f, glm::vec3 centre = glm::vec3(0.0f)) {
+    Mesh m;
+    m.name = "sphere";
+    for (int j = 0; j <= stacks; ++j) {
+        const float phi = std::numbers::pi_v<float> * float(j) / float(stacks);
+        for (int i = 0; i < slices; ++i) {
+            const float theta = 2.0f * std::numbers::pi_v<float> * float(i) / float(slices);
+            m.positions.push_back(centre + radius * glm::vec3(std::sin(phi) * std::cos(theta), std::cos(phi),
+                                                              std::sin(phi) * std::sin(theta)));
+        }
+    }
+    appendSphereGridTriangles(m, slices, stacks);
+    return m;
 }
 
 }  // namespace dyncull::test
