@@ -350,7 +350,7 @@ int main(int argc, char** argv) {
     auto vfcFrame = [](Swarm& s, Shading shading, bool cull, bool discard, bool clusters = true) {
         return [&s, shading, cull, discard, clusters]() -> std::uint64_t {
             SchedulerParams p = s.vfc.params();
-            p.useClusters = clusters;
+            p.features.useClusters = clusters;
             s.vfc.setParams(p);
             s.engine->renderer().setShading(shading);
             s.engine->renderer().setBackFaceCulling(cull);

@@ -53,17 +53,17 @@ bool applyTwoPhaseName(const std::string& part, ModeSpec& m) {
         part != "full-noclusters")
         return false;
     m.scheduler.mode = CullMode::TwoPhase;
-    m.scheduler.useBatchedRaster = part != "full-hzb";
+    m.scheduler.features.useBatchedRaster = part != "full-hzb";
     if (part == "full-tri") {
         // Every part whose volume passed is tested on its triangles: the design measured,
         // not the cost model's choice (which on llvmpipe tests almost none).
-        m.scheduler.useTriangleTests = true;
-        m.scheduler.costs.triangleTestNsPerPart = 0.0;
-        m.scheduler.costs.triangleTestNsPerTriangle = 0.0;
+        m.scheduler.features.useTriangleTests = true;
+        m.scheduler.tuning.costs.triangleTestNsPerPart = 0.0;
+        m.scheduler.tuning.costs.triangleTestNsPerTriangle = 0.0;
     }
-    m.scheduler.useHistory = part != "full-nohist";
-    m.scheduler.useCostModel = part != "full-nocost";
-    m.scheduler.useClusters = part != "full-noclusters";
+    m.scheduler.features.useHistory = part != "full-nohist";
+    m.scheduler.features.useCostModel = part != "full-nocost";
+    m.scheduler.features.useClusters = part != "full-noclusters";
     return true;
 }
 
@@ -84,7 +84,7 @@ std::string modeNamesHelp() {
 
 bool queriesNodeVolumes(const ModeSpec& m) {
     return !m.oracle && (m.scheduler.mode == CullMode::Queries || m.scheduler.mode == CullMode::TwoPhase) &&
-           m.scheduler.useTightVolumes;
+           m.scheduler.features.useTightVolumes;
 }
 
 namespace {
@@ -107,7 +107,7 @@ Status setVolume(std::vector<ModeSpec>& modes, const std::string& volume) {
     if (!v) return Error{"--volume: " + v.error().message};
     for (ModeSpec& m : modes) {
         if (!queriesNodeVolumes(m) || namesVolume(m.name)) continue;
-        m.scheduler.volume = *v;
+        m.scheduler.tuning.volume = *v;
     }
     return {};
 }
@@ -132,7 +132,7 @@ Expected<std::vector<ModeSpec>> withVolumes(std::vector<ModeSpec> modes, const s
         for (VolumeChoice v : volumes) {
             ModeSpec c = m;
             c.name = m.name + "+" + toString(v);
-            c.scheduler.volume = v;
+            c.scheduler.tuning.volume = v;
             out.push_back(std::move(c));
         }
     }
@@ -146,32 +146,32 @@ bool applyQueriesSetting(const std::string& part, ModeSpec& m) {
     std::uint32_t n = 0;
     if (part == "queries") {
     } else if (part == "latency1") {
-        m.scheduler.useLastFrameResults = true;
+        m.scheduler.approx.useLastFrameResults = true;
     } else if (part == "noflush") {
         m.queries.flushAfterBatch = false;
     } else if (part == "overlap") {
-        m.scheduler.batchOverlapping = true;
+        m.scheduler.approx.batchOverlapping = true;
     } else if (part == "queries-nohist") {
-        m.scheduler.useHistory = false;
+        m.scheduler.features.useHistory = false;
     } else if (part == "queries-nobatch") {
-        m.scheduler.useBatching = false;
+        m.scheduler.features.useBatching = false;
     } else if (part == "queries-noocc") {
-        m.scheduler.useOccupancyAccept = false;
+        m.scheduler.features.useOccupancyAccept = false;
     } else if (part == "queries-notight") {
-        m.scheduler.useTightVolumes = false;
+        m.scheduler.features.useTightVolumes = false;
     } else if (part == "queries-nodrawq") {
-        m.scheduler.useDrawQueries = false;
+        m.scheduler.features.useDrawQueries = false;
     } else if (part == "order") {
-        m.scheduler.useWaitOrder = true;
+        m.scheduler.features.useWaitOrder = true;
     } else if (numberAfter(part, "thr", n)) {
         m.queries.visiblePixelThreshold = n;
     } else if (numberAfter(part, "skip", n)) {
-        m.scheduler.history.maxSkipFrames = n;
-        m.scheduler.history.skipFramesPerVisible = 2;
+        m.scheduler.tuning.history.maxSkipFrames = n;
+        m.scheduler.tuning.history.skipFramesPerVisible = 2;
     } else if (numberAfter(part, "small", n)) {
-        m.scheduler.smallFeaturePixels = n;
+        m.scheduler.approx.smallFeaturePixels = n;
     } else if (numberAfter(part, "front", n)) {
-        m.scheduler.frontPercent = static_cast<float>(n);
+        m.scheduler.tuning.frontPercent = static_cast<float>(n);
     } else {
         return false;
     }
@@ -184,7 +184,7 @@ Expected<ModeSpec> modeFromName(const std::string& name) {
     ModeSpec m = queriesMode(name);
     if (name == "vfc" || name == "vfc-noclusters") {
         m.scheduler.mode = CullMode::Vfc;
-        m.scheduler.useClusters = name == "vfc";
+        m.scheduler.features.useClusters = name == "vfc";
     } else if (name == "simple") {
         m.scheduler.mode = CullMode::Simple;
     } else if (name == "oracle") {
@@ -200,7 +200,7 @@ Expected<ModeSpec> modeFromName(const std::string& name) {
             if (auto v = parseVolumeChoice(part)) {
                 if (volume) return Error{"--modes: '" + name + "' names two volumes"};
                 volume = true;
-                m.scheduler.volume = *v;
+                m.scheduler.tuning.volume = *v;
             } else if (!twoPhase && !querySetting && applyTwoPhaseName(part, m)) {
                 twoPhase = true;
             } else if (!twoPhase && applyQueriesSetting(part, m)) {
@@ -251,18 +251,18 @@ Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec) {
         if (param == "pixel-threshold") {
             m.queries.visiblePixelThreshold = v;
         } else if (param == "max-skip") {
-            m.scheduler.history.maxSkipFrames = v;
+            m.scheduler.tuning.history.maxSkipFrames = v;
         } else if (param == "skip-per-visible") {
-            m.scheduler.history.skipFramesPerVisible = v;
+            m.scheduler.tuning.history.skipFramesPerVisible = v;
         } else if (param == "small-feature") {
-            m.scheduler.smallFeaturePixels = v;
+            m.scheduler.approx.smallFeaturePixels = v;
         } else if (param == "max-in-flight") {
-            m.scheduler.maxQueriesInFlight = v;
+            m.scheduler.tuning.maxQueriesInFlight = v;
         } else if (param == "tile-size") {
-            m.scheduler.occupancyTileSize = static_cast<int>(std::min<std::uint32_t>(v, 1u << 20));
+            m.scheduler.tuning.occupancyTileSize = static_cast<int>(std::min<std::uint32_t>(v, 1u << 20));
         } else if (param == "auto-saving") {
-            m.scheduler.volume = VolumeChoice::Auto;
-            m.scheduler.autoVolumeSaving = static_cast<float>(v) / 100.0f;
+            m.scheduler.tuning.volume = VolumeChoice::Auto;
+            m.scheduler.tuning.autoVolumeSaving = static_cast<float>(v) / 100.0f;
         } else {
             return Error{"--param: unknown parameter '" + param + "' (known: " + sweepParamsHelp() + ")"};
         }
@@ -423,7 +423,7 @@ VolumeBound BenchRunner::volumeBound(VolumeChoice volume) {
         ids.clear();
         backend.beginBatch();
         for (std::size_t j = 0; j < n; ++j)
-            ids.push_back(backend.issue(objectNodeVolume(objs, parts[i + j], volume, SchedulerParams{}.autoVolumeSaving)));
+            ids.push_back(backend.issue(objectNodeVolume(objs, parts[i + j], volume, SchedulerParams{}.tuning.autoVolumeSaving)));
         backend.endBatch();
         for (std::size_t j = 0; j < n; ++j) {
             // Unanswered within the bound counts visible, as in the scheduler; so does a
@@ -444,7 +444,7 @@ void BenchRunner::measureLeafVolumes() {
     for (std::size_t m = 0; m < result_.modes.size(); ++m) {
         const ModeSpec& spec = result_.modes[m];
         if (queriesNodeVolumes(spec))
-            result_.leafTotals[m] = leafVolumeTotals(engine_.objects(), spec.scheduler.volume, spec.scheduler.autoVolumeSaving);
+            result_.leafTotals[m] = leafVolumeTotals(engine_.objects(), spec.scheduler.tuning.volume, spec.scheduler.tuning.autoVolumeSaving);
     }
 }
 

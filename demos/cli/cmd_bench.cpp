@@ -20,7 +20,7 @@ struct BenchOptions {
     std::string size = "640x360";
     std::string volume;   // --volume
     std::string volumes;  // --volumes
-    float autoSaving = SchedulerParams{}.autoVolumeSaving;
+    float autoSaving = SchedulerParams{}.tuning.autoVolumeSaving;
 };
 
 std::string ratioText(const std::vector<ModeSummary>& s, const std::string& a, const std::string& b) {
@@ -47,7 +47,7 @@ void runBench(BenchOptions o) {
         modes = expanded.take();
     }
     if (!(o.autoSaving >= 0.0f && o.autoSaving <= 1.0f)) fail("--auto-saving: must be in [0, 1]");
-    for (ModeSpec& m : *modes) m.scheduler.autoVolumeSaving = o.autoSaving;
+    for (ModeSpec& m : *modes) m.scheduler.tuning.autoVolumeSaving = o.autoSaving;
     if (o.measure.out.empty()) o.measure.out = "out/bench_" + o.measure.scene;
     const std::string command = commandLine();
     std::vector<ModeSummary> summary;

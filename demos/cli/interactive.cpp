@@ -27,9 +27,9 @@ InteractiveViewer::InteractiveViewer(Engine& engine, DemoScene& scene, const Int
     : engine_(engine), scene_(scene), options_(options) {
     state_.mode = options.params.mode;
     state_.boxes = options.boxes;
-    state_.useHistory = options.params.useHistory;
-    state_.useOccupancy = options.params.useOccupancyAccept;
-    state_.useTight = options.params.useTightVolumes;
+    state_.useHistory = options.params.features.useHistory;
+    state_.useOccupancy = options.params.features.useOccupancyAccept;
+    state_.useTight = options.params.features.useTightVolumes;
     for (CullMode m : {CullMode::Vfc, CullMode::Simple, CullMode::Queries, CullMode::TwoPhase})
         schedulers_[static_cast<int>(m)] = std::make_unique<QueryScheduler>(paramsFor(m));
 }
@@ -37,9 +37,9 @@ InteractiveViewer::InteractiveViewer(Engine& engine, DemoScene& scene, const Int
 SchedulerParams InteractiveViewer::paramsFor(CullMode mode) const {
     SchedulerParams p = options_.params;
     p.mode = mode;
-    p.useHistory = state_.useHistory;
-    p.useOccupancyAccept = state_.useOccupancy;
-    p.useTightVolumes = state_.useTight;
+    p.features.useHistory = state_.useHistory;
+    p.features.useOccupancyAccept = state_.useOccupancy;
+    p.features.useTightVolumes = state_.useTight;
     return p;
 }
 

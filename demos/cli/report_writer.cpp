@@ -131,7 +131,7 @@ std::vector<ModeSummary> summarise(const BenchResult& r) {
         }
         if (vfcParts > 0) s.pctPartsCulled = 100.0 * (vfcParts - parts) / vfcParts;
         if (!r.frames.empty()) s.queryTriangles = tris / static_cast<double>(r.frames.size());
-        if (queriesNodeVolumes(r.modes[m])) s.volume = toString(r.modes[m].scheduler.volume);
+        if (queriesNodeVolumes(r.modes[m])) s.volume = toString(r.modes[m].scheduler.tuning.volume);
         if (m < r.leafTotals.size()) s.leaves = r.leafTotals[m];
     }
     std::vector<double> ratios;
@@ -340,7 +340,7 @@ PlotOutcome writePlots(const BenchResult& r, const std::vector<ModeSummary>& sum
 
 bool reportsVolumes(const BenchResult& r) {
     return std::any_of(r.modes.begin(), r.modes.end(),
-                       [](const ModeSpec& m) { return queriesNodeVolumes(m) && m.scheduler.volume != SchedulerParams{}.volume; });
+                       [](const ModeSpec& m) { return queriesNodeVolumes(m) && m.scheduler.tuning.volume != SchedulerParams{}.tuning.volume; });
 }
 
 namespace {

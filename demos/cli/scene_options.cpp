@@ -124,16 +124,16 @@ void addSchedulerOptions(CLI::App& cmd, SchedulerFlags& f) {
 SchedulerParams toParams(const SchedulerFlags& f, CullMode mode) {
     SchedulerParams p;
     p.mode = mode;
-    p.useHistory = !f.noHistory;
-    p.useBatching = !f.noBatching;
-    p.useOccupancyAccept = !f.noOccupancy;
-    p.useTightVolumes = !f.noTight;
-    p.useDrawQueries = !f.noDrawQueries;
-    p.maxQueriesInFlight = f.maxInFlight;
-    p.history.maxSkipFrames = f.maxSkip;
-    p.frontPercent = f.frontPercent;
-    p.volume = parseVolumeChoice(f.volume).value();  // checked by the option's IsMember
-    p.autoVolumeSaving = f.autoSaving;
+    p.features.useHistory = !f.noHistory;
+    p.features.useBatching = !f.noBatching;
+    p.features.useOccupancyAccept = !f.noOccupancy;
+    p.features.useTightVolumes = !f.noTight;
+    p.features.useDrawQueries = !f.noDrawQueries;
+    p.tuning.maxQueriesInFlight = f.maxInFlight;
+    p.tuning.history.maxSkipFrames = f.maxSkip;
+    p.tuning.frontPercent = f.frontPercent;
+    p.tuning.volume = parseVolumeChoice(f.volume).value();  // checked by the option's IsMember
+    p.tuning.autoVolumeSaving = f.autoSaving;
     return p;
 }
 

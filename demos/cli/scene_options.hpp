@@ -43,12 +43,12 @@ void addMeasureOptions(CLI::App& cmd, MeasureOptions& o, std::string& size, cons
 /// Scheduler switches for `full` ablations and tuning.
 struct SchedulerFlags {
     bool noHistory = false, noBatching = false, noOccupancy = false, noTight = false, noDrawQueries = false;
-    std::uint32_t maxInFlight = SchedulerParams{}.maxQueriesInFlight;
-    std::uint32_t maxSkip = SchedulerParams{}.history.maxSkipFrames;
+    std::uint32_t maxInFlight = SchedulerParams{}.tuning.maxQueriesInFlight;
+    std::uint32_t maxSkip = SchedulerParams{}.tuning.history.maxSkipFrames;
     std::uint32_t pixelThreshold = 0;
     float frontPercent = 0.0f;
     std::string volume = "auto";  ///< one of aabb, obb, kdop14, kdop18, kdop26, auto (checked by CLI11)
-    float autoSaving = SchedulerParams{}.autoVolumeSaving;
+    float autoSaving = SchedulerParams{}.tuning.autoVolumeSaving;
 };
 void addSchedulerOptions(CLI::App& cmd, SchedulerFlags& f);
 SchedulerParams toParams(const SchedulerFlags& f, CullMode mode);

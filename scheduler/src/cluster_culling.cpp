@@ -18,7 +18,7 @@ using Clock = std::chrono::steady_clock;
 
 bool QueryScheduler::cullClusters(NodeRef ref, const LocalBsp& model, const LocalBspNode& n) {
     clusterRanges_.clear();
-    if (!params_.useClusters || ref.isSceneNode() || !sink_->drawsRanges() || !model.clusters.builtFor(model.nodes.size()))
+    if (!params_.features.useClusters || ref.isSceneNode() || !sink_->drawsRanges() || !model.clusters.builtFor(model.nodes.size()))
         return false;
     const std::span<const LeafCluster> clusters = model.clusters.ofSubtree(ref.node, n.subtreeSize);
     if (clusters.empty()) return false;
@@ -38,8 +38,8 @@ bool QueryScheduler::cullClusters(NodeRef ref, const LocalBsp& model, const Loca
     if (clusterCulledRate_.size() <= modelId) clusterCulledRate_.resize(modelId + 1, 0.5);
     double& rate = clusterCulledRate_[modelId];
     const std::uint32_t triangles = n.indexCount / 3;
-    if (params_.useCostModel && !exploring(ref) &&
-        rate * triangles * params_.costs.drawNsPerTriangle < double(clusters.size()) * params_.costs.clusterTestNs)
+    if (params_.features.useCostModel && !exploring(ref) &&
+        rate * triangles * params_.tuning.costs.drawNsPerTriangle < double(clusters.size()) * params_.tuning.costs.clusterTestNs)
         return false;
 
     const auto t0 = Clock::now();
@@ -73,7 +73,7 @@ bool QueryScheduler::cullClusters(NodeRef ref, const LocalBsp& model, const Loca
         // A gap of culled clusters between two drawn ones costs one more range of the
         // multi-draw: skipped only where it saves more drawing than a range costs.
         IndexRange* last = clusterRanges_.empty() ? nullptr : &clusterRanges_.back();
-        if (last && double(gapTriangles) * params_.costs.drawNsPerTriangle < params_.costs.drawNsPerRange) {
+        if (last && double(gapTriangles) * params_.tuning.costs.drawNsPerTriangle < params_.tuning.costs.drawNsPerRange) {
             last->indexCount = c.firstIndex + c.indexCount - last->firstIndex;
         } else {
             clusterRanges_.push_back({c.firstIndex, c.indexCount});

@@ -64,8 +64,8 @@ void QueryScheduler::drawOccludees() {
             drawNode(root, false);
             continue;
         }
-        const QueryVolume volume = params_.useTightVolumes
-                                       ? objectNodeVolume(objs, root, params_.volume, params_.autoVolumeSaving)
+        const QueryVolume volume = params_.features.useTightVolumes
+                                       ? objectNodeVolume(objs, root, params_.tuning.volume, params_.tuning.autoVolumeSaving)
                                        : QueryVolume::fromAabb(box);
         ScreenRect rect;
         float nearest = 1.0f;

@@ -56,17 +56,17 @@ Expected<CullMode> parseCullMode(const std::string& s) {
 }
 
 Status validateSchedulerParams(const SchedulerParams& p) {
-    if (p.maxQueriesInFlight == 0) return Error{"maxQueriesInFlight must be at least 1"};
-    if (p.occupancyTileSize <= 0) return Error{"occupancyTileSize must be positive"};
-    if (!(p.queryTimeoutMs > 0.0)) return Error{"queryTimeoutMs must be positive"};
-    if (p.history.maxSkipFrames > 1000) return Error{"history.maxSkipFrames must be at most 1000"};
-    if (!(p.frontPercent >= 0.0f && p.frontPercent <= 100.0f)) return Error{"frontPercent must be in [0, 100]"};
-    if (!(p.autoVolumeSaving >= 0.0f && p.autoVolumeSaving <= 1.0f)) return Error{"autoVolumeSaving must be in [0, 1]"};
-    if (static_cast<int>(p.volume) > static_cast<int>(VolumeChoice::Auto)) return Error{"volume has an unknown value"};
-    for (double c : {p.costs.drawNsPerTriangle, p.costs.testNsPerVolume, p.costs.testNsPerPixel, p.costs.depthReadNs,
-                     p.costs.triangleTestNsPerPart, p.costs.triangleTestNsPerTriangle})
+    if (p.tuning.maxQueriesInFlight == 0) return Error{"maxQueriesInFlight must be at least 1"};
+    if (p.tuning.occupancyTileSize <= 0) return Error{"occupancyTileSize must be positive"};
+    if (!(p.tuning.queryTimeoutMs > 0.0)) return Error{"queryTimeoutMs must be positive"};
+    if (p.tuning.history.maxSkipFrames > 1000) return Error{"history.maxSkipFrames must be at most 1000"};
+    if (!(p.tuning.frontPercent >= 0.0f && p.tuning.frontPercent <= 100.0f)) return Error{"frontPercent must be in [0, 100]"};
+    if (!(p.tuning.autoVolumeSaving >= 0.0f && p.tuning.autoVolumeSaving <= 1.0f)) return Error{"autoVolumeSaving must be in [0, 1]"};
+    if (static_cast<int>(p.tuning.volume) > static_cast<int>(VolumeChoice::Auto)) return Error{"volume has an unknown value"};
+    for (double c : {p.tuning.costs.drawNsPerTriangle, p.tuning.costs.testNsPerVolume, p.tuning.costs.testNsPerPixel, p.tuning.costs.depthReadNs,
+                     p.tuning.costs.triangleTestNsPerPart, p.tuning.costs.triangleTestNsPerTriangle})
         if (!(c >= 0.0 && c < 1e12)) return Error{"costs must be finite and non-negative (nanoseconds)"};
-    if (p.costs.probeFrames == 0) return Error{"costs.probeFrames must be at least 1"};
+    if (p.tuning.costs.probeFrames == 0) return Error{"costs.probeFrames must be at least 1"};
     return {};
 }
 
@@ -96,11 +96,11 @@ FrameStats QueryScheduler::cullFrame(const TwoLevelTree& tree, const FrameView& 
     active_.clear();
     pending_.clear();
     if (trace_) trace_->clear();
-    if (drawnMap_.tilesX() * params_.occupancyTileSize < width || drawnMap_.tilesY() * params_.occupancyTileSize < height ||
-        (drawnMap_.tilesX() - 1) * params_.occupancyTileSize >= width) {
-        drawnMap_.reset(width, height, params_.occupancyTileSize);
-        pendingMap_.reset(width, height, params_.occupancyTileSize);
-        waitingMap_.reset(width, height, params_.occupancyTileSize);
+    if (drawnMap_.tilesX() * params_.tuning.occupancyTileSize < width || drawnMap_.tilesY() * params_.tuning.occupancyTileSize < height ||
+        (drawnMap_.tilesX() - 1) * params_.tuning.occupancyTileSize >= width) {
+        drawnMap_.reset(width, height, params_.tuning.occupancyTileSize);
+        pendingMap_.reset(width, height, params_.tuning.occupancyTileSize);
+        waitingMap_.reset(width, height, params_.tuning.occupancyTileSize);
     } else {
         drawnMap_.clear();
         pendingMap_.clear();
@@ -116,8 +116,8 @@ FrameStats QueryScheduler::cullFrame(const TwoLevelTree& tree, const FrameView& 
     const Aabb rootBox = tree.worldBox(tree.root());
     if (!rootBox.empty()) active_.push_back(tree.root());
     frontBudget_ = frontLeavesSeen_ = 0;
-    if (params_.mode != CullMode::Vfc && params_.frontPercent > 0.0f && !rootBox.empty())
-        frontBudget_ = static_cast<std::uint32_t>(std::ceil(double(params_.frontPercent) / 100.0 * countFrustumLeaves()));
+    if (params_.mode != CullMode::Vfc && params_.tuning.frontPercent > 0.0f && !rootBox.empty())
+        frontBudget_ = static_cast<std::uint32_t>(std::ceil(double(params_.tuning.frontPercent) / 100.0 * countFrustumLeaves()));
     if (params_.mode != CullMode::Queries) {
         // Switched away from Queries: its last draw queries will not be read.
         for (const Pending& p : drawQueries_) backend.release(p.id);
@@ -265,13 +265,13 @@ QueryScheduler::FirstTest QueryScheduler::firstVisibilityTest(NodeRef ref, const
         return FirstTest::Visible;
     }
     if (params_.mode != CullMode::Queries) return FirstTest::NeedQuery;
-    if (params_.smallFeaturePixels > 0 && static_cast<std::uint32_t>(rect.area()) < params_.smallFeaturePixels) {
+    if (params_.approx.smallFeaturePixels > 0 && static_cast<std::uint32_t>(rect.area()) < params_.approx.smallFeaturePixels) {
         ++st.smallFeatureCulled;
         h.lastVisible = false;
         trace(ref, box, NodeState::SmallFeature);
         return FirstTest::Invisible;
     }
-    if (params_.useHistory && history_.canSkipQuery(ref, h, frame_, params_.history)) {
+    if (params_.features.useHistory && history_.canSkipQuery(ref, h, frame_, params_.tuning.history)) {
         ++st.skippedByHistory;
         trace(ref, box, NodeState::VisibleHistory);
         return FirstTest::Visible;
@@ -280,11 +280,11 @@ QueryScheduler::FirstTest QueryScheduler::firstVisibilityTest(NodeRef ref, const
 }
 
 QueryVolume QueryScheduler::queryVolume(NodeRef ref, const Aabb& worldBox) const {
-    if (ref.isSceneNode() || params_.mode != CullMode::Queries || !params_.useTightVolumes) return QueryVolume::fromAabb(worldBox);
+    if (ref.isSceneNode() || params_.mode != CullMode::Queries || !params_.features.useTightVolumes) return QueryVolume::fromAabb(worldBox);
     // Tightened volume: the node's own object-space volume under the object's matrix
     // instead of its world AABB, once the object has kept its transform for a few frames.
-    if (frame_ - stillSince_[ref.object] < params_.tightenAfterFrames) return QueryVolume::fromAabb(worldBox);
-    return objectNodeVolume(tree_->objects(), ref, params_.volume, params_.autoVolumeSaving);
+    if (frame_ - stillSince_[ref.object] < params_.tuning.tightenAfterFrames) return QueryVolume::fromAabb(worldBox);
+    return objectNodeVolume(tree_->objects(), ref, params_.tuning.volume, params_.tuning.autoVolumeSaving);
 }
 
 QueryVolume objectNodeVolume(const SceneObjects& objs, NodeRef ref, VolumeChoice volume, float autoSaving) {
@@ -322,7 +322,7 @@ void QueryScheduler::drawNode(NodeRef ref, bool untested) {
         else
             sink_->drawPart(ref, n.firstIndex, n.indexCount);
     };
-    if (untested && params_.mode == CullMode::Queries && params_.useDrawQueries) {
+    if (untested && params_.mode == CullMode::Queries && params_.features.useDrawQueries) {
         const QueryId id = backend_->beginDrawQuery();
         draw();
         if (id != kNoQuery) {
@@ -341,7 +341,7 @@ void QueryScheduler::drawNode(NodeRef ref, bool untested) {
     } else {
         for (const IndexRange& r : clusterRanges_) stats_->trianglesDrawn += r.indexCount / 3;
     }
-    if (params_.mode == CullMode::Queries && params_.useOccupancyAccept) {
+    if (params_.mode == CullMode::Queries && params_.features.useOccupancyAccept) {
         ScreenRect r;
         projectRect(tree_->worldBox(ref), r);
         drawnMap_.mark(r);
@@ -430,7 +430,7 @@ void QueryScheduler::runSimple() {
             ++stats_->queriesIssued;
             ++stats_->batches;
             const auto tw = Clock::now();
-            const QueryResult r = backend_->wait(id, params_.queryTimeoutMs);
+            const QueryResult r = backend_->wait(id, params_.tuning.queryTimeoutMs);
             stats_->waitMs += msSince(tw);
             backend_->release(id);
             if (r == QueryResult::NotReady) ++stats_->queriesTimedOut;
@@ -527,9 +527,9 @@ void QueryScheduler::runQueries() {
     };
     // Issue a query for `ref` now if allowed; false if it must wait.
     auto tryIssue = [&](NodeRef ref, const Aabb& box, const ScreenRect& rect) -> bool {
-        if (pending_.size() >= params_.maxQueriesInFlight) return false;
-        if (params_.useBatching) {
-            if (!params_.batchOverlapping && pendingMap_.anySet(rect)) return false;
+        if (pending_.size() >= params_.tuning.maxQueriesInFlight) return false;
+        if (params_.features.useBatching) {
+            if (!params_.approx.batchOverlapping && pendingMap_.anySet(rect)) return false;
         } else if (!pending_.empty()) {
             return false;  // no batching: one query in flight at a time
         }
@@ -543,7 +543,7 @@ void QueryScheduler::runQueries() {
         openBatch();
         const QueryId id = timedIssue(queryVolume(ref, box));
         ++stats_->queriesIssued;
-        const bool marked = params_.useBatching;
+        const bool marked = params_.features.useBatching;
         if (marked) pendingMap_.mark(rect);
         pending_.push_back(pendingOf(ref, id, rect, marked));
         return true;
@@ -569,13 +569,13 @@ void QueryScheduler::runQueries() {
         deferred.insert(at, w);
         waitingMap_.mark(rect);
     };
-    const bool keepOrder = params_.useWaitOrder && !params_.batchOverlapping;
+    const bool keepOrder = params_.features.useWaitOrder && !params_.approx.batchOverlapping;
     // Occupancy-map fast accept: a rectangle touching screen area where nothing has been
     // drawn cannot be hidden. Tested as soon as a node is reached, even if a nearer waiting
     // node overlaps it: deferring the test too waited far longer for few parts saved
     // (docs/BENCHMARKS.md, "Waiting order").
     auto occupancyAccept = [&](NodeRef ref, const Aabb& box, const ScreenRect& rect) -> bool {
-        if (!params_.useOccupancyAccept || drawnMap_.allSet(rect)) return false;
+        if (!params_.features.useOccupancyAccept || drawnMap_.allSet(rect)) return false;
         ++stats_->skippedByOccupancy;
         NodeHistory& h = history_.at(ref, objs);
         history_.recordAnswer(h, true, frame_);
@@ -630,7 +630,7 @@ void QueryScheduler::runQueries() {
             ScreenRect rect;
             projectRect(box, rect);
             if (occupancyAccept(ref, box, rect)) continue;
-            if (!params_.useLastFrameResults) {
+            if (!params_.approx.useLastFrameResults) {
                 if ((keepOrder && !deferred.empty() && waitingMap_.anySet(rect)) || !tryIssue(ref, box, rect))
                     defer(ref, box, rect);
             } else {
@@ -678,7 +678,7 @@ void QueryScheduler::runQueries() {
         // 4. Nothing else to do: wait for the oldest query.
         if (!progress && active_.empty() && !pending_.empty()) {
             const auto tw = Clock::now();
-            const QueryResult r = backend_->wait(pending_.front().id, params_.queryTimeoutMs);
+            const QueryResult r = backend_->wait(pending_.front().id, params_.tuning.queryTimeoutMs);
             stats_->waitMs += msSince(tw);
             Pending p = pending_.front();
             pending_.erase(pending_.begin());

@@ -65,7 +65,7 @@ bool QueryScheduler::projectVolumeDepth(const QueryVolume& volume, ScreenRect& r
 void QueryScheduler::runTwoPhase() {
     const SceneObjects& objs = tree_->objects();
     const NodeRef root = active_.empty() ? NodeRef{} : active_.back();
-    const bool triangles = params_.useTriangleTests && sink_->testsTriangles();
+    const bool triangles = params_.features.useTriangleTests && sink_->testsTriangles();
     markedDraws_.clear();
     if (triangles) {
         sink_->beginDrawMarks();
@@ -96,8 +96,8 @@ void QueryScheduler::runTwoPhase() {
     // 2. The early pass's depth, unless the cost model turned this frame's tests off. A
     // backend that cannot read depth leaves the pyramid unbuilt, and an unbuilt pyramid
     // calls nothing occluded.
-    const bool testing = !params_.useCostModel || savedNs_ > params_.costs.depthReadNs ||
-                         frame_ - lastTestedFrame_ >= params_.costs.probeFrames;
+    const bool testing = !params_.features.useCostModel || savedNs_ > params_.tuning.costs.depthReadNs ||
+                         frame_ - lastTestedFrame_ >= params_.tuning.costs.probeFrames;
     culledTriangles_ = 0;
     bool haveDepth = false;
     if (testing) {
@@ -115,7 +115,7 @@ void QueryScheduler::runTwoPhase() {
     candidates_.clear();
     refresh_.clear();
     triangleTests_.clear();
-    const bool raster = params_.useBatchedRaster && testing;
+    const bool raster = params_.features.useBatchedRaster && testing;
     if (!(root == NodeRef{})) active_.push_back(root);
     while (!active_.empty()) {
         const NodeRef ref = active_.back();
@@ -139,9 +139,9 @@ void QueryScheduler::runTwoPhase() {
         float nearest = 1.0f;
         // Object nodes by their own volume (a transformed box or k-DOP, tighter than the
         // world box of a rotated part), scene nodes by their box; both grown by rounding.
-        const QueryVolume volume = ref.isSceneNode() || !params_.useTightVolumes
+        const QueryVolume volume = ref.isSceneNode() || !params_.features.useTightVolumes
                                        ? QueryVolume::fromAabb(box)
-                                       : objectNodeVolume(objs, ref, params_.volume, params_.autoVolumeSaving);
+                                       : objectNodeVolume(objs, ref, params_.tuning.volume, params_.tuning.autoVolumeSaving);
         const bool inFront = projectVolumeDepth(volume, rect, nearest);
         bool certain = false;  // visible without any test (near plane, camera inside)
         if (!inFront || box.contains(camera_.position)) {
@@ -174,9 +174,9 @@ void QueryScheduler::runTwoPhase() {
             // postpone it further, but not past history's longest postponement, so every
             // part is tested now and then and the rate of culling tests stays measured.
             const std::uint32_t sinceAnswer = frame_ - h.lastQueryFrame;
-            if (params_.useHistory && sinceAnswer <= history_.postponement(ref, h, params_.history)) {
+            if (params_.features.useHistory && sinceAnswer <= history_.postponement(ref, h, params_.tuning.history)) {
                 ++stats_->skippedByHistory;
-            } else if (sinceAnswer <= params_.history.maxSkipFrames && !worthTesting(ref, rect, refreshOccludedRate_)) {
+            } else if (sinceAnswer <= params_.tuning.history.maxSkipFrames && !worthTesting(ref, rect, refreshOccludedRate_)) {
                 ++stats_->skippedByCost;
             } else {
                 refresh_.push_back({ref, volume});
@@ -236,7 +236,7 @@ void QueryScheduler::runTwoPhase() {
     // testing saves; without them the frame says nothing and the estimate stands.
     if (testing && (drewEarly || !refresh_.empty() || triangles)) {
         lastTestedFrame_ = frame_;
-        savedNs_ = double(culledTriangles_) * params_.costs.drawNsPerTriangle;
+        savedNs_ = double(culledTriangles_) * params_.tuning.costs.drawNsPerTriangle;
     }
 }
 
@@ -285,15 +285,15 @@ void QueryScheduler::readDrawMarks() {
 }
 
 bool QueryScheduler::worthTriangleTest(NodeRef ref) {
-    if (!params_.useCostModel) return true;
-    const SchedulerParams::TestCosts& c = params_.costs;
+    if (!params_.features.useCostModel) return true;
+    const TestCosts& c = params_.tuning.costs;
     const double triangles = double(subtreeTriangles(ref));
     return triangleOccludedRate_ * triangles * c.drawNsPerTriangle > c.triangleTestNsPerPart + triangles * c.triangleTestNsPerTriangle;
 }
 
 bool QueryScheduler::worthTesting(NodeRef ref, const ScreenRect& rect, double occludedRate) {
-    if (!params_.useCostModel) return true;
-    const SchedulerParams::TestCosts& c = params_.costs;
+    if (!params_.features.useCostModel) return true;
+    const TestCosts& c = params_.tuning.costs;
     return occludedRate * double(subtreeTriangles(ref)) * c.drawNsPerTriangle > c.testNsPerVolume + c.testNsPerPixel * rect.area();
 }
 
@@ -331,7 +331,7 @@ void QueryScheduler::rasterTest(const std::vector<TestedPart>& parts) {
     rasterAnswers_.assign(parts.size(), QueryResult::Visible);
     const BatchId batch = backend_->testVolumes(rasterVolumes_);
     if (batch != kNoBatch) {
-        backend_->collectVolumes(batch, rasterAnswers_, params_.queryTimeoutMs);  // nothing else to do meanwhile
+        backend_->collectVolumes(batch, rasterAnswers_, params_.tuning.queryTimeoutMs);  // nothing else to do meanwhile
         ++stats_->rasterBatches;
         stats_->rasterTests += static_cast<std::uint32_t>(parts.size());
     }

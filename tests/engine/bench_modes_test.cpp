@@ -13,28 +13,28 @@ TEST(BenchModes, BaseModes) {
     EXPECT_TRUE(modeFromName("oracle")->oracle);
     const ModeSpec full = modeFromName("full").take();
     EXPECT_EQ(full.scheduler.mode, CullMode::TwoPhase);
-    EXPECT_TRUE(full.scheduler.useBatchedRaster && full.scheduler.useCostModel && full.scheduler.useHistory);
+    EXPECT_TRUE(full.scheduler.features.useBatchedRaster && full.scheduler.features.useCostModel && full.scheduler.features.useHistory);
     EXPECT_EQ(full.scheduler.mode, SchedulerParams{}.mode) << "full is the library's default";
     const ModeSpec queries = modeFromName("queries").take();
     EXPECT_EQ(queries.scheduler.mode, CullMode::Queries);
     EXPECT_EQ(queries.queries.visiblePixelThreshold, 0u);  // conservative by default
-    EXPECT_FALSE(queries.scheduler.useLastFrameResults);
+    EXPECT_FALSE(queries.scheduler.approx.useLastFrameResults);
 }
 
 TEST(BenchModes, AblationsOfFullAndTheirVolumes) {
-    EXPECT_FALSE(modeFromName("full-hzb")->scheduler.useBatchedRaster);
-    EXPECT_FALSE(modeFromName("full-nohist")->scheduler.useHistory);
-    EXPECT_FALSE(modeFromName("full-nocost")->scheduler.useCostModel);
-    EXPECT_FALSE(modeFromName("full")->scheduler.useTriangleTests);
-    EXPECT_TRUE(modeFromName("full-tri")->scheduler.useTriangleTests);
-    EXPECT_TRUE(modeFromName("full")->scheduler.useClusters);
-    EXPECT_FALSE(modeFromName("full-noclusters")->scheduler.useClusters);
-    EXPECT_TRUE(modeFromName("vfc")->scheduler.useClusters);
-    EXPECT_FALSE(modeFromName("vfc-noclusters")->scheduler.useClusters);
+    EXPECT_FALSE(modeFromName("full-hzb")->scheduler.features.useBatchedRaster);
+    EXPECT_FALSE(modeFromName("full-nohist")->scheduler.features.useHistory);
+    EXPECT_FALSE(modeFromName("full-nocost")->scheduler.features.useCostModel);
+    EXPECT_FALSE(modeFromName("full")->scheduler.features.useTriangleTests);
+    EXPECT_TRUE(modeFromName("full-tri")->scheduler.features.useTriangleTests);
+    EXPECT_TRUE(modeFromName("full")->scheduler.features.useClusters);
+    EXPECT_FALSE(modeFromName("full-noclusters")->scheduler.features.useClusters);
+    EXPECT_TRUE(modeFromName("vfc")->scheduler.features.useClusters);
+    EXPECT_FALSE(modeFromName("vfc-noclusters")->scheduler.features.useClusters);
     EXPECT_EQ(modeFromName("vfc-noclusters")->scheduler.mode, CullMode::Vfc);
     const ModeSpec k = modeFromName("full+kdop26").take();
     EXPECT_EQ(k.scheduler.mode, CullMode::TwoPhase);
-    EXPECT_EQ(k.scheduler.volume, VolumeChoice::Kdop26);
+    EXPECT_EQ(k.scheduler.tuning.volume, VolumeChoice::Kdop26);
     // Settings of queries do not combine with full, either way round.
     for (const char* bad : {"full+thr16", "thr16+full", "full+full-hzb"}) {
         auto m = modeFromName(bad);
@@ -45,11 +45,11 @@ TEST(BenchModes, AblationsOfFullAndTheirVolumes) {
 
 TEST(BenchModes, PresetsSetOneThing) {
     EXPECT_EQ(modeFromName("thr16")->queries.visiblePixelThreshold, 16u);
-    EXPECT_EQ(modeFromName("small4")->scheduler.smallFeaturePixels, 4u);
-    EXPECT_TRUE(modeFromName("latency1")->scheduler.useLastFrameResults);
-    EXPECT_TRUE(modeFromName("overlap")->scheduler.batchOverlapping);
-    EXPECT_FALSE(modeFromName("queries-nohist")->scheduler.useHistory);
-    EXPECT_EQ(modeFromName("skip20")->scheduler.history.maxSkipFrames, 20u);
+    EXPECT_EQ(modeFromName("small4")->scheduler.approx.smallFeaturePixels, 4u);
+    EXPECT_TRUE(modeFromName("latency1")->scheduler.approx.useLastFrameResults);
+    EXPECT_TRUE(modeFromName("overlap")->scheduler.approx.batchOverlapping);
+    EXPECT_FALSE(modeFromName("queries-nohist")->scheduler.features.useHistory);
+    EXPECT_EQ(modeFromName("skip20")->scheduler.tuning.history.maxSkipFrames, 20u);
 }
 
 TEST(BenchModes, SettingsCombineWithPlus) {
@@ -57,9 +57,9 @@ TEST(BenchModes, SettingsCombineWithPlus) {
     EXPECT_EQ(m.name, "thr16+latency1+queries-noocc");
     EXPECT_EQ(m.scheduler.mode, CullMode::Queries);
     EXPECT_EQ(m.queries.visiblePixelThreshold, 16u);
-    EXPECT_TRUE(m.scheduler.useLastFrameResults);
-    EXPECT_FALSE(m.scheduler.useOccupancyAccept);
-    EXPECT_TRUE(m.scheduler.useHistory);
+    EXPECT_TRUE(m.scheduler.approx.useLastFrameResults);
+    EXPECT_FALSE(m.scheduler.features.useOccupancyAccept);
+    EXPECT_TRUE(m.scheduler.features.useHistory);
 }
 
 TEST(BenchModes, BadNamesAreErrorsNamingThePart) {

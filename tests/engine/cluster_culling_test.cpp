@@ -29,8 +29,8 @@ std::uint64_t differingPixels(const Image& a, const Image& b) {
 SchedulerParams paramsOf(CullMode mode, bool clusters) {
     SchedulerParams p;
     p.mode = mode;
-    p.useClusters = clusters;
-    p.useCostModel = false;  // test every cluster
+    p.features.useClusters = clusters;
+    p.features.useCostModel = false;  // test every cluster
     return p;
 }
 

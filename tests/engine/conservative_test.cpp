@@ -100,7 +100,7 @@ TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
     // The test checks culling, not latency: a query that outlasts the default 250 ms bound
     // (llvmpipe on a loaded 2-core CI machine, or under the sanitizers) is counted visible
     // and would only make the no-timeout check below flaky. 20 s still ends every frame.
-    for (cli::ModeSpec& m : *modes) m.scheduler.queryTimeoutMs = 20000.0;
+    for (cli::ModeSpec& m : *modes) m.scheduler.tuning.queryTimeoutMs = 20000.0;
     auto runner = cli::BenchRunner::create(*engine, *scene, modes.take());
     ASSERT_TRUE(runner.ok()) << runner.error().message;
     (*runner)->setMeasureVolumeBound(true);

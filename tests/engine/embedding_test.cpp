@@ -213,10 +213,10 @@ TEST(Embedding, GameStateAndFramebufferAreUntouchedByAFrame) {
     queries.mode = CullMode::Queries;
     QueryScheduler queryScheduler(queries);
     SchedulerParams alwaysTest;  // two-phase testing every frame (the cost model would pause)
-    alwaysTest.useCostModel = false;
+    alwaysTest.features.useCostModel = false;
     QueryScheduler testingScheduler(alwaysTest);
     SchedulerParams triangles = alwaysTest;  // and on the parts' own triangles, draws marked
-    triangles.useTriangleTests = true;
+    triangles.features.useTriangleTests = true;
     QueryScheduler triangleScheduler(triangles);
 
     // Frames of the default mode, of two-phase with its depth readback and batched raster
@@ -404,7 +404,7 @@ TEST(Embedding, TwoViewsAndTwoEnginesDrawSideBySide) {
     ASSERT_TRUE(second.ok()) << second.error().message;
     const ViewId back = *second;
     SchedulerParams invalid = queries;
-    invalid.maxQueriesInFlight = 0;
+    invalid.tuning.maxQueriesInFlight = 0;
     EXPECT_FALSE(engine.addView(behind, invalid).ok());
     Camera aside = front;  // the second engine's scene from higher up
     aside.position = {1.0f, 2.0f, 3.0f};

@@ -31,15 +31,15 @@ struct Rig {
     QueryScheduler queries{[] {
         SchedulerParams p;
         p.mode = CullMode::Queries;
-        p.queryTimeoutMs = 20000.0;  // culling is checked here, not latency
+        p.tuning.queryTimeoutMs = 20000.0;  // culling is checked here, not latency
         return p;
     }()};
     QueryScheduler full{[] {
         SchedulerParams p;  // the default: two-phase
-        p.queryTimeoutMs = 20000.0;
+        p.tuning.queryTimeoutMs = 20000.0;
         // These scenes are tiny: the cost model would find the tests dearer than the
         // drawing they save and switch them off, and the tests are what is checked here.
-        p.useCostModel = false;
+        p.features.useCostModel = false;
         return p;
     }()};
 

@@ -21,8 +21,8 @@ using test::at;
 SchedulerParams modeParams(CullMode mode, bool triangles = false) {
     SchedulerParams p;
     p.mode = mode;
-    p.useCostModel = false;  // two-phase tests every frame
-    p.useTriangleTests = triangles;
+    p.features.useCostModel = false;  // two-phase tests every frame
+    p.features.useTriangleTests = triangles;
     return p;
 }
 

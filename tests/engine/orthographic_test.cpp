@@ -50,8 +50,8 @@ TEST(Orthographic, ProjectionIsReversedZeroToOneAndLinear) {
 SchedulerParams modeParams(CullMode mode, bool triangles = false) {
     SchedulerParams p;
     p.mode = mode;
-    p.useCostModel = false;
-    p.useTriangleTests = triangles;
+    p.features.useCostModel = false;
+    p.features.useTriangleTests = triangles;
     return p;
 }
 

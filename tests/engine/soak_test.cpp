@@ -105,7 +105,7 @@ TEST(Soak, TenThousandFramesOfAMovingSwarm) {
     // Wall-clock bound per query: on a machine shared with other jobs llvmpipe can exceed
     // the default 250 ms (the node then counts visible, correctly); the soak checks that
     // no query is lost, so it allows 20 s.
-    eo.scheduler.queryTimeoutMs = 20000.0;
+    eo.scheduler.tuning.queryTimeoutMs = 20000.0;
     auto engineOr = Engine::create(*ctx, eo);
     ASSERT_TRUE(engineOr.ok()) << engineOr.error().message;
     Engine& engine = **engineOr;

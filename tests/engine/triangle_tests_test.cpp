@@ -64,9 +64,9 @@ struct StripScene {
 SchedulerParams twoPhase(bool triangles) {
     SchedulerParams p;
     p.mode = CullMode::TwoPhase;
-    p.useCostModel = false;      // test every volume and every part
-    p.useTightVolumes = false;   // boxes: the strip's pokes out whatever the k-DOP would do
-    p.useTriangleTests = triangles;
+    p.features.useCostModel = false;      // test every volume and every part
+    p.features.useTightVolumes = false;   // boxes: the strip's pokes out whatever the k-DOP would do
+    p.features.useTriangleTests = triangles;
     return p;
 }
 

@@ -153,7 +153,7 @@ TEST(QueryScheduler, AllVisibleDrawsExactlyWhatVfcDraws) {
             b.latency = latency;
             SchedulerParams p = queriesParams();
             p.mode = mode;
-            p.useOccupancyAccept = false;  // force queries
+            p.features.useOccupancyAccept = false;  // force queries
             FrameStats st;
             const auto drawn = drawnWith(s, p, b, &st);
             EXPECT_EQ(drawn, reference) << toString(mode) << " latency " << latency;
@@ -170,8 +170,8 @@ TEST(QueryScheduler, QueriesThatNeverAnswerCountAsVisibleAndTheFrameEnds) {
     ScriptedBackend b;
     b.neverAnswer = true;
     SchedulerParams p = queriesParams();
-    p.useOccupancyAccept = false;
-    p.queryTimeoutMs = 1.0;
+    p.features.useOccupancyAccept = false;
+    p.tuning.queryTimeoutMs = 1.0;
     FrameStats st;
     const auto drawn = drawnWith(s, p, b, &st);
     EXPECT_EQ(drawn, reference);
@@ -192,7 +192,7 @@ TEST(QueryScheduler, OccludedAnswersCullButNeverNearOrInsideBoxes) {
     for (CullMode mode : {CullMode::Simple, CullMode::Queries}) {
         SchedulerParams p = queriesParams();
         p.mode = mode;
-        p.useOccupancyAccept = false;
+        p.features.useOccupancyAccept = false;
         FrameStats st;
         const auto drawn = drawnWith(s, p, b, &st);
         EXPECT_EQ(drawn.count(around.index), 1u) << toString(mode);
@@ -216,7 +216,7 @@ TEST(QueryScheduler, HistorySkipsQueriesForNodesVisibleRecently) {
     TestScene s(5, 4);
     ScriptedBackend b;
     SchedulerParams p = queriesParams();
-    p.useOccupancyAccept = false;
+    p.features.useOccupancyAccept = false;
     QueryScheduler sched(p);
     TwoLevelTree tree(s.bsp, s.objects);
     std::vector<std::uint32_t> issued;
@@ -231,7 +231,7 @@ TEST(QueryScheduler, HistorySkipsQueriesForNodesVisibleRecently) {
     EXPECT_LT(*std::min_element(issued.begin() + 2, issued.end()), issued[0]);
 
     // Without history every frame issues the same number of queries.
-    p.useHistory = false;
+    p.features.useHistory = false;
     QueryScheduler plain(p);
     std::set<std::uint32_t> counts;
     for (int f = 0; f < 5; ++f) {
@@ -246,7 +246,7 @@ TEST(QueryScheduler, OccludedNodesAreQueriedAgainEveryFrame) {
     ScriptedBackend b;
     b.rule = [](const QueryVolume&) { return QueryResult::Occluded; };
     SchedulerParams p = queriesParams();
-    p.useOccupancyAccept = false;
+    p.features.useOccupancyAccept = false;
     QueryScheduler sched(p);
     TwoLevelTree tree(s.bsp, s.objects);
     std::uint32_t first = 0;
@@ -264,8 +264,8 @@ TEST(QueryScheduler, BatchesHoldOnlyNonOverlappingRectangles) {
     ScriptedBackend b;
     b.latency = 2;
     SchedulerParams p = queriesParams();
-    p.useOccupancyAccept = false;
-    p.occupancyTileSize = 8;
+    p.features.useOccupancyAccept = false;
+    p.tuning.occupancyTileSize = 8;
     const Camera cam = frontCamera();
     const glm::mat4 vp = cam.viewProjection();
     drawnWith(s, p, b);
@@ -312,9 +312,9 @@ TEST(QueryScheduler, WithWaitOrderAFartherNodeNeverOvertakesAWaitingNearerNodeIt
     ScriptedBackend b;
     b.latency = 2;
     SchedulerParams p = queriesParams();
-    p.useOccupancyAccept = false;  // an empty screen would accept everything
-    p.occupancyTileSize = 8;
-    p.useWaitOrder = true;
+    p.features.useOccupancyAccept = false;  // an empty screen would accept everything
+    p.tuning.occupancyTileSize = 8;
+    p.features.useWaitOrder = true;
     QueryScheduler sched(p);
     RecordingSink sink;
     TwoLevelTree tree(bsp, objects);
@@ -336,10 +336,10 @@ TEST(QueryScheduler, WithWaitOrderAFartherNodeNeverOvertakesAWaitingNearerNodeIt
 TEST(QueryScheduler, ParamsAreValidated) {
     SchedulerParams p = queriesParams();
     EXPECT_TRUE(validateSchedulerParams(p).ok());
-    p.maxQueriesInFlight = 0;
+    p.tuning.maxQueriesInFlight = 0;
     EXPECT_FALSE(validateSchedulerParams(p).ok());
     p = {};
-    p.occupancyTileSize = 0;
+    p.tuning.occupancyTileSize = 0;
     EXPECT_FALSE(validateSchedulerParams(p).ok());
     EXPECT_FALSE(parseCullMode("fast").ok());
     EXPECT_EQ(parseCullMode("full").value(), CullMode::TwoPhase);
@@ -373,7 +373,7 @@ std::vector<bool> drawnWhenAllOccluded(const glm::vec3& eye, float nearPlane, fl
     ScriptedBackend b;
     b.rule = [](const QueryVolume&) { return QueryResult::Occluded; };
     SchedulerParams p = queriesParams();
-    p.useOccupancyAccept = false;
+    p.features.useOccupancyAccept = false;
     QueryScheduler sched(p);
     RecordingSink sink;
     TwoLevelTree tree(bsp, objects);
@@ -429,8 +429,8 @@ TEST(QueryScheduler, FrontMostLeavesAreDrawnWithoutQueries) {
             b.rule = [](const QueryVolume&) { return QueryResult::Occluded; };
             SchedulerParams p = queriesParams();
             p.mode = mode;
-            p.useOccupancyAccept = false;
-            p.frontPercent = percent;
+            p.features.useOccupancyAccept = false;
+            p.tuning.frontPercent = percent;
             FrameStats st;
             const auto drawn = drawnWith(s, p, b, &st);
             const auto budget = static_cast<std::size_t>(std::ceil(percent / 100.0f * 30.0f));
@@ -444,7 +444,7 @@ TEST(QueryScheduler, FrontMostLeavesAreDrawnWithoutQueries) {
         }
     }
     SchedulerParams bad;
-    bad.frontPercent = 150.0f;
+    bad.tuning.frontPercent = 150.0f;
     EXPECT_FALSE(validateSchedulerParams(bad));
 }
 
@@ -489,9 +489,9 @@ TEST(QueryScheduler, ObjectNodesAreQueriedWithTheChosenVolume) {
         SCOPED_TRACE(toString(c));
         ScriptedBackend b;
         SchedulerParams p = queriesParams();
-        p.useOccupancyAccept = false;  // force queries
-        p.useHistory = false;
-        p.volume = c;
+        p.features.useOccupancyAccept = false;  // force queries
+        p.features.useHistory = false;
+        p.tuning.volume = c;
         QueryScheduler sched(p);
         RecordingSink sink;
         const FrameStats st = sched.cullFrame(tree, frontCamera(), 640, 320, b, sink);
@@ -513,9 +513,9 @@ TEST(QueryScheduler, ObjectNodesAreQueriedWithTheChosenVolume) {
         ScriptedBackend b;
         SchedulerParams p = queriesParams();
         p.mode = simple ? CullMode::Simple : CullMode::Queries;
-        p.useTightVolumes = simple;
-        p.useOccupancyAccept = false;
-        p.volume = VolumeChoice::Kdop26;
+        p.features.useTightVolumes = simple;
+        p.features.useOccupancyAccept = false;
+        p.tuning.volume = VolumeChoice::Kdop26;
         QueryScheduler sched(p);
         RecordingSink sink;
         sched.cullFrame(tree, frontCamera(), 640, 320, b, sink);
@@ -640,9 +640,9 @@ TEST(QueryScheduler, DrawQueriesKeepVisiblePartsUnqueriedAndRequeryPartsThatDrew
         SCOPED_TRACE(drawQueries ? "draw queries" : "history only");
         DrawQueryBackend b;
         SchedulerParams p = queriesParams();
-        p.useOccupancyAccept = false;  // every part needs a query or history
-        p.history.jitter = false;
-        p.useDrawQueries = drawQueries;
+        p.features.useOccupancyAccept = false;  // every part needs a query or history
+        p.tuning.history.jitter = false;
+        p.features.useDrawQueries = drawQueries;
         QueryScheduler sched(p);
         TwoLevelTree tree(s.bsp, s.objects);
         auto frame = [&] {
@@ -731,7 +731,7 @@ TEST(QueryFaults, HungQueriesInTheWaitPathCountVisibleWithinTheBound) {
     HungBackend b;
     SchedulerParams p = queriesParams();
     p.mode = CullMode::Simple;
-    p.queryTimeoutMs = 2.0;
+    p.tuning.queryTimeoutMs = 2.0;
     QueryScheduler sched(p);
     RecordingSink sink;
     TwoLevelTree tree(s.bsp, s.objects);
@@ -757,10 +757,10 @@ TEST(QueryFaults, HungQueriesInTheNonBlockingPathCountVisibleWithinTheBound) {
     HungBackend b;
     SchedulerParams p = queriesParams();
     p.mode = CullMode::Queries;
-    p.useOccupancyAccept = false;  // force queries
-    p.useHistory = false;
-    p.maxQueriesInFlight = 3;
-    p.queryTimeoutMs = 1.0;
+    p.features.useOccupancyAccept = false;  // force queries
+    p.features.useHistory = false;
+    p.tuning.maxQueriesInFlight = 3;
+    p.tuning.queryTimeoutMs = 1.0;
     QueryScheduler sched(p);
     RecordingSink sink;
     TwoLevelTree tree(s.bsp, s.objects);
@@ -785,9 +785,9 @@ TEST(QueryFaults, HungQueriesWithLastFrameResultsNeverCullAndNeverPileUp) {
     const auto reference = vfcDrawn(s);
     HungBackend b;
     SchedulerParams p = queriesParams();
-    p.useOccupancyAccept = false;
-    p.useHistory = false;
-    p.useLastFrameResults = true;
+    p.features.useOccupancyAccept = false;
+    p.features.useHistory = false;
+    p.approx.useLastFrameResults = true;
     QueryScheduler sched(p);
     RecordingSink sink;
     TwoLevelTree tree(s.bsp, s.objects);
@@ -849,10 +849,10 @@ TEST(QueryFaults, AnswersForARemovedObjectAreDroppedWhenItsSlotIsReused) {
         return std::max({e.x, e.y, e.z}) < 0.65f ? QueryResult::Occluded : QueryResult::Visible;
     };
     SchedulerParams p = queriesParams();
-    p.useLastFrameResults = true;
-    p.useHistory = false;
-    p.useOccupancyAccept = false;
-    p.useDrawQueries = false;
+    p.approx.useLastFrameResults = true;
+    p.features.useHistory = false;
+    p.features.useOccupancyAccept = false;
+    p.features.useDrawQueries = false;
     QueryScheduler sched(p);
     RecordingSink sink;
     {
@@ -935,8 +935,8 @@ TEST(TwoPhaseCosts, TestsStopWhereTheyCullNothingAndResumeWhenTheyWould) {
     const auto reference = vfcDrawn(s);
     DepthBackend backend;
     SchedulerParams p = twoPhase();
-    p.costs.probeFrames = 8;
-    p.costs.depthReadNs = 1000.0;  // less than drawing this small scene's 144 triangles
+    p.tuning.costs.probeFrames = 8;
+    p.tuning.costs.depthReadNs = 1000.0;  // less than drawing this small scene's 144 triangles
     QueryScheduler sched(p);
     TwoLevelTree tree(s.bsp, s.objects);
     std::vector<std::uint32_t> testedFrames;
@@ -967,7 +967,7 @@ TEST(TwoPhaseCosts, TestsStopWhereTheyCullNothingAndResumeWhenTheyWould) {
     EXPECT_EQ(drawnAt27, 0u);
 
     // The ablation tests every frame.
-    p.useCostModel = false;
+    p.features.useCostModel = false;
     QueryScheduler always(p);
     DepthBackend b2;
     for (int f = 0; f < 5; ++f) {
@@ -986,7 +986,7 @@ TEST(TwoPhaseCosts, PartsAreTestedOnlyWhereTheTestPays) {
     TwoLevelTree tree(s.bsp, s.objects);
     for (double ns : {0.0, 1e6}) {
         SchedulerParams p = twoPhase();
-        p.costs.drawNsPerTriangle = ns;
+        p.tuning.costs.drawNsPerTriangle = ns;
         QueryScheduler sched(p);
         DepthBackend backend;
         RecordingSink sink;
@@ -1018,8 +1018,8 @@ TEST(TwoPhaseCosts, AFrameWithoutEarlyDepthDoesNotTurnTheTestsOff) {
     TestScene s(4, 3);
     DepthBackend backend;
     SchedulerParams p = twoPhase();
-    p.useBatchedRaster = false;
-    p.costs.depthReadNs = 1000.0;
+    p.features.useBatchedRaster = false;
+    p.tuning.costs.depthReadNs = 1000.0;
     QueryScheduler sched(p);
     TwoLevelTree tree(s.bsp, s.objects);
     RecordingSink first;

@@ -21,22 +21,22 @@ struct FrameStats {
     std::uint32_t triangleTests = 0;  ///< two-phase: parts tested on their own triangles (PartSink::testParts)
     double triangleTestMs = 0.0;      ///< two-phase: drawing and waiting for the triangle tests, and reading the draw marks
     std::uint32_t drawMarksHidden = 0;  ///< two-phase: parts drawn whose draw showed no sample
-    std::uint32_t clusterTests = 0;     ///< clusters of drawn parts tested (SchedulerParams::useClusters)
+    std::uint32_t clusterTests = 0;     ///< clusters of drawn parts tested (SchedulerFeatures::useClusters)
     std::uint32_t clustersCulled = 0;   ///< of those, left undrawn: facing away, outside the frustum or behind the pyramid
     std::uint64_t clusterTrianglesCulled = 0;  ///< their triangles (not in trianglesDrawn)
     double clusterMs = 0.0;             ///< CPU in the cluster tests
     std::uint64_t queryTriangles = 0;   ///< triangles of the query volumes drawn (12 per box)
     std::uint32_t queriesOccluded = 0;  ///< answered "occluded"
     std::uint32_t queriesTimedOut = 0;  ///< never answered within the bound; counted visible
-    /// Queries on parts drawn without a query (SchedulerParams::useDrawQueries); not in queriesIssued.
+    /// Queries on parts drawn without a query (SchedulerFeatures::useDrawQueries); not in queriesIssued.
     std::uint32_t drawQueries = 0;
     std::uint32_t drawQueriesOccluded = 0;  ///< last frame's draw queries read this frame that drew no sample
     std::uint32_t drawQueriesLate = 0;      ///< last frame's draw queries still unanswered at this frame's end (dropped)
     std::uint32_t skippedByHistory = 0;  ///< queries not issued thanks to visibility history
-    std::uint32_t skippedByCost = 0;  ///< two-phase: volumes left untested by the cost model (SchedulerParams::useCostModel)
+    std::uint32_t skippedByCost = 0;  ///< two-phase: volumes left untested by the cost model (SchedulerFeatures::useCostModel)
     std::uint32_t skippedByOccupancy = 0;  ///< visible without a query: rectangle touched empty screen
     std::uint32_t visibleNearOrInside = 0;  ///< visible without a query: camera inside / near plane crossed
-    std::uint32_t visibleFront = 0;  ///< visible without a query: front-most leaves (SchedulerParams::frontPercent)
+    std::uint32_t visibleFront = 0;  ///< visible without a query: front-most leaves (SchedulerTuning::frontPercent)
     std::uint32_t frustumCulled = 0;
     std::uint32_t smallFeatureCulled = 0;  ///< approximate small-feature setting
     std::uint32_t nodesVisited = 0;

@@ -42,9 +42,10 @@ inline constexpr int kCullModeCount = 4;
 const char* toString(CullMode m);
 Expected<CullMode> parseCullMode(const std::string& s);
 
-struct SchedulerParams {
-    CullMode mode = CullMode::TwoPhase;
-    // Ablation switches: useHistory for Queries and TwoPhase, the next three for Queries.
+/// Which parts of the method run. The defaults are the method as measured best; each
+/// switch turned off is an ablation, and none of them trades pixels for speed.
+struct SchedulerFeatures {
+    // useHistory for Queries and TwoPhase, the next three for Queries.
     bool useHistory = true;
     bool useBatching = true;
     bool useOccupancyAccept = true;
@@ -55,7 +56,6 @@ struct SchedulerParams {
     /// waits 1.4-4x as long: from as fast to 23% slower on llvmpipe (docs/BENCHMARKS.md),
     /// hence off; a GPU, where overdraw costs more than a stall, may differ.
     bool useWaitOrder = false;
-
     /// Every part drawn without a query of its own (history, occupancy, near plane,
     /// front-most) is drawn inside a query on its geometry; next frame a part whose
     /// geometry drew no sample is queried again instead of being skipped by history.
@@ -63,7 +63,84 @@ struct SchedulerParams {
     /// 2004, which the two-level paper cites): it catches visible -> hidden at once
     /// instead of after up to history.maxSkipFrames frames, with no volume to rasterise.
     bool useDrawQueries = true;
+    /// TwoPhase: a part the depth pyramid cannot reject goes to the backend's batched
+    /// raster test (QueryBackend::testVolumes), exact per pixel, before it is drawn; and
+    /// the parts drawn early are tested again against the frame's final depth, so a part
+    /// that turned hidden is not drawn early next frame. Off: such parts are drawn (the
+    /// pyramid alone, an ablation).
+    bool useBatchedRaster = true;
+    /// TwoPhase, where the PartSink can (PartSink::testsTriangles: the engine's part
+    /// renderer): a part that the volume tests let through is tested on its own triangles
+    /// before it is drawn (where the cost model expects it to pay), and every draw is
+    /// marked with whether it showed a sample, which replaces the volume test against the
+    /// final depth. The exact test on the geometry itself, where a volume around it peeks
+    /// out from behind occluders the part does not. Off by default: on llvmpipe a test
+    /// costs 1.3x drawing the same triangles and a marked draw 1.2x a plain one, so it
+    /// loses there (docs/BENCHMARKS.md); it pays where shading, not triangle set-up, is
+    /// what drawing costs.
+    bool useTriangleTests = false;
+    /// Every mode, where the PartSink draws index ranges (PartSink::drawsRanges: the
+    /// engine's part renderer): a part is drawn as those of its clusters (leaf_clusters.hpp)
+    /// that survive three tests too cheap to need a query, in one multi-draw: facing away
+    /// from the eye (the normal cone, for models whose back faces the sink culls), outside
+    /// the frustum (for parts crossing it), and, in TwoPhase's late pass, behind the depth
+    /// pyramid. Conservative like the part tests: a culled cluster shows no pixel. The cost
+    /// model weighs `clusterTestNs` per cluster against the drawing it saves, at each
+    /// model's measured rate. Off: whole parts (an ablation).
+    bool useClusters = true;
+    /// TwoPhase (and clusters): test only where SchedulerTuning::costs expects the test to
+    /// pay. Off: every volume the pyramid lets through is tested (an ablation).
+    bool useCostModel = true;
+};
 
+/// Approximate settings (Queries only). Each may drop visible pixels; `dyncull bench`
+/// measures how many. The defaults are conservative.
+struct SchedulerApproximations {
+    /// Cull nodes whose screen rectangle covers fewer than this many pixels (0 = off).
+    std::uint32_t smallFeaturePixels = 0;
+    /// Decide with the node's previous answer instead of waiting; the query issued now
+    /// is read next frame (one frame of latency, no waiting at all).
+    bool useLastFrameResults = false;
+    /// Issue queries even when their rectangles overlap pending ones (more answers
+    /// "visible" than needed; measured, conservative in itself).
+    bool batchOverlapping = false;
+};
+
+/// TwoPhase's cost model: a volume the pyramid cannot reject is tested only where the
+/// test is expected to pay. Its cost is `testNsPerVolume` plus `testNsPerPixel` per
+/// pixel of its screen rectangle; what it saves is the part's triangles times
+/// `drawNsPerTriangle`, times the measured rate at which such tests answer "occluded"
+/// (kept per kind: parts new this frame, and parts drawn early being tested again).
+/// Otherwise the part is simply drawn. The same model turns a frame's tests off (no
+/// depth readback, no test: every part in the frustum drawn) while the last frame
+/// tested culled less drawing than `depthReadNs`, the readback and the stall it causes
+/// (the late pass cannot start before the early pass is rasterised); it tests again
+/// every `probeFrames` frames to see whether that has changed. Costs in nanoseconds of
+/// GL time; the defaults were measured on llvmpipe at 640x360 (`bench_draw_speed`,
+/// `bench_volume_tests`, and for the readback `full-hzb` against `vfc` on Sponza;
+/// docs/BENCHMARKS.md), and another GL needs its own.
+/// A triangle test (useTriangleTests) costs `triangleTestNsPerPart` plus
+/// `triangleTestNsPerTriangle` per triangle, and is weighed the same way; the default is
+/// 1.3x drawNsPerTriangle, as measured (`bench_draw_speed`: test-hidden against parts),
+/// so on llvmpipe only the exploring eighth of the parts is tested. A cluster's tests
+/// (useClusters) cost `clusterTestNs` of CPU (the swarm's `ms_clusters` over
+/// `cluster_tests`), and a gap of culled clusters between drawn ones is skipped only if
+/// its drawing costs more than `drawNsPerRange`, one more range of the multi-draw
+/// (`bench_draw_speed`: parts-clusters against parts; nothing measurable on llvmpipe).
+struct TestCosts {
+    double drawNsPerTriangle = 53.0;
+    double testNsPerVolume = 5000.0;
+    double testNsPerPixel = 1.5;
+    double triangleTestNsPerPart = 0.0;
+    double triangleTestNsPerTriangle = 69.0;
+    double clusterTestNs = 90.0;
+    double drawNsPerRange = 0.0;
+    double depthReadNs = 400000.0;
+    std::uint32_t probeFrames = 16;
+};
+
+/// Numbers that change how fast culling is, never what it draws wrongly.
+struct SchedulerTuning {
     HistoryParams history;
     std::uint32_t maxQueriesInFlight = 64;
     int occupancyTileSize = 16;  ///< pixels per tile side of both occupancy maps
@@ -94,79 +171,16 @@ struct SchedulerParams {
     /// 4, which uses about 5% for CAD and 10-15% for architecture). Costs one hierarchical
     /// frustum count per frame; conservative (it only adds draws). 0 = off, at most 100.
     float frontPercent = 0.0f;
-
-    // Approximate settings (Queries only). Each may drop visible pixels; `dyncull bench`
-    // measures how many. Defaults are conservative.
-    /// Cull nodes whose screen rectangle covers fewer than this many pixels (0 = off).
-    std::uint32_t smallFeaturePixels = 0;
-    /// Decide with the node's previous answer instead of waiting; the query issued now
-    /// is read next frame (one frame of latency, no waiting at all).
-    bool useLastFrameResults = false;
-    /// Issue queries even when their rectangles overlap pending ones (more answers
-    /// "visible" than needed; measured, conservative in itself).
-    bool batchOverlapping = false;
-
-    /// TwoPhase: a part the depth pyramid cannot reject goes to the backend's batched
-    /// raster test (QueryBackend::testVolumes), exact per pixel, before it is drawn; and
-    /// the parts drawn early are tested again against the frame's final depth, so a part
-    /// that turned hidden is not drawn early next frame. Off: such parts are drawn (the
-    /// pyramid alone, an ablation).
-    bool useBatchedRaster = true;
-    /// TwoPhase, where the PartSink can (PartSink::testsTriangles: the engine's part
-    /// renderer): a part that the volume tests let through is tested on its own triangles
-    /// before it is drawn (where the cost model expects it to pay), and every draw is
-    /// marked with whether it showed a sample, which replaces the volume test against the
-    /// final depth. The exact test on the geometry itself, where a volume around it peeks
-    /// out from behind occluders the part does not. Off by default: on llvmpipe a test
-    /// costs 1.3x drawing the same triangles and a marked draw 1.2x a plain one, so it
-    /// loses there (docs/BENCHMARKS.md); it pays where shading, not triangle set-up, is
-    /// what drawing costs.
-    bool useTriangleTests = false;
-    /// Every mode, where the PartSink draws index ranges (PartSink::drawsRanges: the
-    /// engine's part renderer): a part is drawn as those of its clusters (leaf_clusters.hpp)
-    /// that survive three tests too cheap to need a query, in one multi-draw: facing away
-    /// from the eye (the normal cone, for models whose back faces the sink culls), outside
-    /// the frustum (for parts crossing it), and, in TwoPhase's late pass, behind the depth
-    /// pyramid. Conservative like the part tests: a culled cluster shows no pixel. The cost
-    /// model weighs `clusterTestNs` per cluster against the drawing it saves, at each
-    /// model's measured rate. Off: whole parts (an ablation).
-    bool useClusters = true;
-
-    /// TwoPhase's cost model: a volume the pyramid cannot reject is tested only where the
-    /// test is expected to pay. Its cost is `testNsPerVolume` plus `testNsPerPixel` per
-    /// pixel of its screen rectangle; what it saves is the part's triangles times
-    /// `drawNsPerTriangle`, times the measured rate at which such tests answer "occluded"
-    /// (kept per kind: parts new this frame, and parts drawn early being tested again).
-    /// Otherwise the part is simply drawn. The same model turns a frame's tests off (no
-    /// depth readback, no test: every part in the frustum drawn) while the last frame
-    /// tested culled less drawing than `depthReadNs`, the readback and the stall it causes
-    /// (the late pass cannot start before the early pass is rasterised); it tests again
-    /// every `probeFrames` frames to see whether that has changed. Costs in nanoseconds of
-    /// GL time; the defaults were measured on llvmpipe at 640x360 (`bench_draw_speed`,
-    /// `bench_volume_tests`, and for the readback `full-hzb` against `vfc` on Sponza;
-    /// docs/BENCHMARKS.md), and another GL needs its own.
-    /// A triangle test (useTriangleTests) costs `triangleTestNsPerPart` plus
-    /// `triangleTestNsPerTriangle` per triangle, and is weighed the same way; the default is
-    /// 1.3x drawNsPerTriangle, as measured (`bench_draw_speed`: test-hidden against parts),
-    /// so on llvmpipe only the exploring eighth of the parts is tested. A cluster's tests
-    /// (useClusters) cost `clusterTestNs` of CPU (the swarm's `ms_clusters` over
-    /// `cluster_tests`), and a gap of culled clusters between drawn ones is skipped only if
-    /// its drawing costs more than `drawNsPerRange`, one more range of the multi-draw
-    /// (`bench_draw_speed`: parts-clusters against parts; nothing measurable on llvmpipe).
-    struct TestCosts {
-        double drawNsPerTriangle = 53.0;
-        double testNsPerVolume = 5000.0;
-        double testNsPerPixel = 1.5;
-        double triangleTestNsPerPart = 0.0;
-        double triangleTestNsPerTriangle = 69.0;
-        double clusterTestNs = 90.0;
-        double drawNsPerRange = 0.0;
-        double depthReadNs = 400000.0;
-        std::uint32_t probeFrames = 16;
-    };
     TestCosts costs;
-    /// Off: every volume the pyramid lets through is tested (an ablation).
-    bool useCostModel = true;
+};
+
+/// Everything a QueryScheduler is configured with, grouped by what a setting may change:
+/// the mode, which parts of the method run, what may be traded for pixels, and speed.
+struct SchedulerParams {
+    CullMode mode = CullMode::TwoPhase;
+    SchedulerFeatures features;
+    SchedulerApproximations approx;
+    SchedulerTuning tuning;
 };
 
 /// What the scheduler decided for a node reached during a frame (for the node-box view
@@ -183,7 +197,7 @@ enum class NodeState : std::uint8_t {
     VisibleVfc,         ///< vfc mode: in the frustum
     VisibleCheaper,     ///< two-phase: drawn untested, since the cost model expects the test to cost more than it saves
     VisibleOccluder,    ///< an occluder-only object (OcclusionRole): drawn whole and untested whenever in the frustum
-    ClusterCulled,      ///< decided visible, but none of its clusters survived their tests (SchedulerParams::useClusters): not drawn
+    ClusterCulled,      ///< decided visible, but none of its clusters survived their tests (SchedulerFeatures::useClusters): not drawn
 };
 const char* toString(NodeState s);
 
