@@ -6,28 +6,24 @@
 // ../shared/notes/batched-occlusion-tests.md). The finer level of "model only what a scene
 // requires": the BSP's parts stay the unit of queries and history, clusters are tested
 // only through these cheap paths, and only where the measured savings pay for the tests.
-#include <chrono>
 
-#include "dyncull/scheduler/query_scheduler.hpp"
+#include "cull_frame.hpp"
 
 namespace dyncull {
 
-namespace {
-using Clock = std::chrono::steady_clock;
-}  // namespace
 
-bool QueryScheduler::cullClusters(NodeRef ref, const LocalBsp& model, const LocalBspNode& n) {
+bool QueryScheduler::cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, const LocalBspNode& n) {
     clusterRanges_.clear();
-    if (!params_.features.useClusters || ref.isSceneNode() || !sink_->drawsRanges() || !model.clusters.builtFor(model.nodes.size()))
+    if (!params_.features.useClusters || ref.isSceneNode() || !f.sink.drawsRanges() || !model.clusters.builtFor(model.nodes.size()))
         return false;
     const std::span<const LeafCluster> clusters = model.clusters.ofSubtree(ref.node, n.subtreeSize);
     if (clusters.empty()) return false;
-    const SceneObjects& objs = tree_->objects();
+    const SceneObjects& objs = f.objects;
     // Which tests can cull anything here: cones only where back faces are culled, the
     // frustum only for a part crossing it, the pyramid only after the early pass.
-    const bool cones = model.faces == FaceMode::CullBack && sink_->cullsBackFaces();
-    const bool frustum = frustum_.classify(tree_->worldBox(ref)) != Frustum::Side::Inside;
-    const bool pyramid = clusterPyramid_;
+    const bool cones = model.faces == FaceMode::CullBack && f.sink.cullsBackFaces();
+    const bool frustum = f.frustum().classify(f.tree.worldBox(ref)) != Frustum::Side::Inside;
+    const bool pyramid = f.clusterPyramid;
     if (!cones && !frustum && !pyramid) return false;
     if (!cones && !pyramid && clusters.size() == 1) return false;  // the part's own frustum test said it all
 
@@ -42,26 +38,26 @@ bool QueryScheduler::cullClusters(NodeRef ref, const LocalBsp& model, const Loca
         rate * triangles * params_.tuning.costs.drawNsPerTriangle < double(clusters.size()) * params_.tuning.costs.clusterTestNs)
         return false;
 
-    const auto t0 = Clock::now();
+    const auto t0 = SchedulerClock::now();
     const glm::mat4& matrix = objs.matrix(ref.object);
     // The eye in the object's space (affine maps keep which side of a plane a point is on,
     // mirroring included, as the rasteriser's facing follows the transformed winding).
     const glm::dmat4 toObject = glm::inverse(glm::dmat4(matrix));
-    const bool ortho = camera_.orthographic();
-    const glm::dvec3 eye = glm::dvec3(toObject * glm::dvec4(glm::dvec3(camera_.position), 1.0));
-    const glm::dvec3 along = glm::dvec3(toObject * glm::dvec4(glm::dvec3(camera_.forward()), 0.0));
+    const bool ortho = f.camera().orthographic();
+    const glm::dvec3 eye = glm::dvec3(toObject * glm::dvec4(glm::dvec3(f.camera().position), 1.0));
+    const glm::dvec3 along = glm::dvec3(toObject * glm::dvec4(glm::dvec3(f.camera().forward()), 0.0));
     std::uint64_t culledTriangles = 0, gapTriangles = 0;
     std::uint32_t culledClusters = 0, gapClusters = 0;
     for (const LeafCluster& c : clusters) {
         bool culled = cones && (ortho ? c.backFacingAlong(along) : c.backFacingFrom(eye));
         if (!culled && (frustum || pyramid)) {
             const Aabb world = transformAabb(matrix, c.box);
-            culled = frustum && frustum_.outside(world);
-            if (!culled && pyramid && !world.contains(camera_.position)) {
+            culled = frustum && f.frustum().outside(world);
+            if (!culled && pyramid && !world.contains(f.camera().position)) {
                 ScreenRect rect;
                 float nearest = 1.0f;
                 // A cluster reaching the near plane is visible; one off screen shows nothing.
-                if (projectVolumeDepth(QueryVolume::fromTransformedBox(matrix, c.box), rect, nearest))
+                if (f.screen.volumeDepth(QueryVolume::fromTransformedBox(matrix, c.box), rect, nearest))
                     culled = rect.empty() || pyramid_.occluded(rect, nearest);
             }
         }
@@ -85,10 +81,10 @@ bool QueryScheduler::cullClusters(NodeRef ref, const LocalBsp& model, const Loca
     }
     culledClusters += gapClusters;  // after the last drawn one: costs no range
     culledTriangles += gapTriangles;
-    stats_->clusterTests += static_cast<std::uint32_t>(clusters.size());
-    stats_->clustersCulled += culledClusters;
-    stats_->clusterTrianglesCulled += culledTriangles;
-    stats_->clusterMs += std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    f.stats.clusterTests += static_cast<std::uint32_t>(clusters.size());
+    f.stats.clustersCulled += culledClusters;
+    f.stats.clusterTrianglesCulled += culledTriangles;
+    f.stats.clusterMs += msSince(t0);
     rate += 0.02 * (double(culledTriangles) / double(triangles > 0 ? triangles : 1) - rate);
     return true;
 }

@@ -7,14 +7,14 @@
 // conservative in every mode.
 #include <algorithm>
 
-#include "dyncull/scheduler/query_scheduler.hpp"
+#include "cull_frame.hpp"
 
 namespace dyncull {
 
-void QueryScheduler::pushChildren(NodeRef ref) {
+void QueryScheduler::pushChildren(Frame& f, NodeRef ref) {
     scratch_.clear();
-    tree_->expand(ref, camera_.position, scratch_);
-    const SceneObjects& objs = tree_->objects();
+    f.tree.expand(ref, f.camera().position, scratch_);
+    const SceneObjects& objs = f.objects;
     if (ref.isSceneNode() && !objs.roleSlots().empty())
         std::erase_if(scratch_, [&](const NodeRef& r) { return !r.isSceneNode() && objs.role(r.object) != OcclusionRole::Both; });
     // active_ is a stack whose back is processed next: push the farthest first.
@@ -40,28 +40,28 @@ void inFrustum(const SceneObjects& objs, OcclusionRole role, const Frustum& frus
 }
 }  // namespace
 
-void QueryScheduler::drawOccluders() {
-    const SceneObjects& objs = tree_->objects();
+void QueryScheduler::drawOccluders(Frame& f) {
+    const SceneObjects& objs = f.objects;
     if (objs.roleSlots().empty()) return;
-    inFrustum(objs, OcclusionRole::OccluderOnly, frustum_, camera_.position, roleOrder_, stats_->frustumCulled);
+    inFrustum(objs, OcclusionRole::OccluderOnly, f.frustum(), f.camera().position, roleOrder_, f.stats.frustumCulled);
     for (const auto& [distance, slot] : roleOrder_) {
         const NodeRef root{slot, 0};
-        trace(root, objs.worldBox(slot), NodeState::VisibleOccluder);
-        drawNode(root, false);  // the whole object: its root's range is every part
+        f.note(root, objs.worldBox(slot), NodeState::VisibleOccluder);
+        drawNode(f, root, false);  // the whole object: its root's range is every part
     }
 }
 
-void QueryScheduler::drawOccludees() {
-    const SceneObjects& objs = tree_->objects();
+void QueryScheduler::drawOccludees(Frame& f) {
+    const SceneObjects& objs = f.objects;
     if (objs.roleSlots().empty()) return;
-    inFrustum(objs, OcclusionRole::OccludeeOnly, frustum_, camera_.position, roleOrder_, stats_->frustumCulled);
+    inFrustum(objs, OcclusionRole::OccludeeOnly, f.frustum(), f.camera().position, roleOrder_, f.stats.frustumCulled);
     candidates_.clear();
     for (const auto& [distance, slot] : roleOrder_) {
         const NodeRef root{slot, 0};
         const Aabb& box = objs.worldBox(slot);
         if (params_.mode == CullMode::Vfc) {
-            trace(root, box, NodeState::VisibleVfc);
-            drawNode(root, false);
+            f.note(root, box, NodeState::VisibleVfc);
+            drawNode(f, root, false);
             continue;
         }
         const QueryVolume volume = params_.features.useTightVolumes
@@ -69,28 +69,28 @@ void QueryScheduler::drawOccludees() {
                                        : QueryVolume::fromAabb(box);
         ScreenRect rect;
         float nearest = 1.0f;
-        if (!projectVolumeDepth(volume, rect, nearest) || box.contains(camera_.position)) {
-            ++stats_->visibleNearOrInside;
-            trace(root, box, NodeState::VisibleNear);
-            drawNode(root, false);
+        if (!f.screen.volumeDepth(volume, rect, nearest) || box.contains(f.camera().position)) {
+            ++f.stats.visibleNearOrInside;
+            f.note(root, box, NodeState::VisibleNear);
+            drawNode(f, root, false);
         } else if (rect.empty()) {
-            ++stats_->frustumCulled;
-            trace(root, box, NodeState::FrustumCulled);
+            ++f.stats.frustumCulled;
+            f.note(root, box, NodeState::FrustumCulled);
         } else {
             candidates_.push_back({root, volume});
         }
     }
     if (candidates_.empty()) return;
     // One batch: occludees draw no depth, so none can hide another.
-    rasterTest(candidates_);
+    rasterTest(f, candidates_);
     for (std::size_t i = 0; i < candidates_.size(); ++i) {
         const NodeRef root = candidates_[i].ref;
         if (rasterAnswers_[i] == QueryResult::Occluded) {
-            ++stats_->queriesOccluded;
-            trace(root, objs.worldBox(root.object), NodeState::Occluded);
+            ++f.stats.queriesOccluded;
+            f.note(root, objs.worldBox(root.object), NodeState::Occluded);
         } else {
-            trace(root, objs.worldBox(root.object), NodeState::VisibleQueried);
-            drawNode(root, false);
+            f.note(root, objs.worldBox(root.object), NodeState::VisibleQueried);
+            drawNode(f, root, false);
         }
     }
 }

@@ -22,115 +22,108 @@
 // Conservative: whatever is not drawn was hidden behind depth that the final image also
 // has (the early parts are drawn, and depth only grows nearer afterwards).
 #include <algorithm>
-#include <array>
 #include <cassert>
-#include <chrono>
-#include <cmath>
 
-#include "dyncull/scheduler/query_scheduler.hpp"
+#include "cull_frame.hpp"
 
 namespace dyncull {
 
-namespace {
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
-}  // namespace
-
-bool QueryScheduler::projectVolumeDepth(const QueryVolume& volume, ScreenRect& rect, float& nearestDepth) const {
-    // The volume grown by the rounding of its float vertices, projected in double; any
-    // point within the near-plane margin makes it "crossing" (visible), as in projectRect.
-    std::array<glm::dvec3, QueryVolume::kMaxVertices> rel;
-    bool asBox = false;
-    const std::uint32_t n = volume.enlargedForRounding(glm::dvec3(camera_.position), rel, asBox);
-    double magnitude = 0.0;
-    for (std::uint32_t i = 0; i < n; ++i)
-        magnitude = std::max({magnitude, std::abs(rel[i].x), std::abs(rel[i].y), std::abs(rel[i].z)});
-    const double nearPlane = double(camera_.nearPlane);
-    const double nearTest = nearPlane + 0x1p-21 * magnitude + 0x1p-22 * nearPlane;
-    glm::dvec2 lo(1e300), hi(-1e300);
-    double nearest = 0.0;
-    for (std::uint32_t i = 0; i < n; ++i) {
-        const glm::dvec4 clip = viewProj_ * glm::dvec4(rel[i], 1.0);
-        if (viewDistance(clip, rel[i]) < nearTest) return false;
-        const glm::dvec2 ndc = glm::dvec2(clip) / clip.w;
-        lo = glm::min(lo, ndc);
-        hi = glm::max(hi, ndc);
-        nearest = std::max(nearest, clip.z / clip.w);
-    }
-    rect = pixelRect(lo, hi);
-    nearestDepth = static_cast<float>(nearest);
-    return true;
-}
-
-void QueryScheduler::runTwoPhase() {
-    const SceneObjects& objs = tree_->objects();
+void QueryScheduler::runTwoPhase(Frame& f) {
     const NodeRef root = active_.empty() ? NodeRef{} : active_.back();
-    const bool triangles = params_.features.useTriangleTests && sink_->testsTriangles();
+    const bool triangles = params_.features.useTriangleTests && f.sink.testsTriangles();
     markedDraws_.clear();
     if (triangles) {
-        sink_->beginDrawMarks();
-        marking_ = true;
+        f.sink.beginDrawMarks();
+        f.marking = true;
     }
 
-    // 1. Early pass. lastTouchedFrame marks a part drawn in it.
-    const std::uint32_t partsBefore = stats_->partsDrawn;
-    while (!active_.empty()) {
-        const NodeRef ref = active_.back();
-        active_.pop_back();
-        ++stats_->nodesVisited;
-        if (frustum_.outside(tree_->worldBox(ref))) continue;
-        NodeHistory& h = history_.at(ref, objs);
-        if (!tree_->isDrawable(ref)) {
-            pushChildren(ref);
-            continue;
-        }
-        if (h.lastVisible && h.lastVisibleFrame + 1 == frame_) {
-            trace(ref, tree_->worldBox(ref), NodeState::VisibleHistory);  // drawn untested
-            drawNode(ref, false);
-            h.lastTouchedFrame = frame_;
-        }
-    }
-
-    const bool drewEarly = stats_->partsDrawn > partsBefore;
+    // 1. Early pass.
+    const bool drewEarly = drawEarlySet(f);
 
     // 2. The early pass's depth, unless the cost model turned this frame's tests off. A
     // backend that cannot read depth leaves the pyramid unbuilt, and an unbuilt pyramid
     // calls nothing occluded.
     const bool testing = !params_.features.useCostModel || savedNs_ > params_.tuning.costs.depthReadNs ||
-                         frame_ - lastTestedFrame_ >= params_.tuning.costs.probeFrames;
+                         f.index - lastTestedFrame_ >= params_.tuning.costs.probeFrames;
     culledTriangles_ = 0;
     bool haveDepth = false;
     if (testing) {
-        const auto t0 = Clock::now();
+        const auto t0 = SchedulerClock::now();
         int w = 0, hgt = 0;
-        haveDepth = backend_->readDepth(depth_, w, hgt) && w == width_ && hgt == height_;
+        haveDepth = f.backend.readDepth(depth_, w, hgt) && w == f.view.width && hgt == f.view.height;
         if (haveDepth) pyramid_.build(depth_, w, hgt);
-        clusterPyramid_ = haveDepth;  // the late pass's draws test their clusters against it too
-        stats_->depthReadMs += msSince(t0);
+        f.clusterPyramid = haveDepth;  // the late pass's draws test their clusters against it too
+        f.stats.depthReadMs += msSince(t0);
     }
 
-    // 3. Late pass. Parts the pyramid cannot reject are either drawn at once or, with the
-    // batched raster test, collected in `candidates_` and tested exactly afterwards; the
-    // parts drawn early are collected in `refresh_` to be tested against the final depth.
+    // 3. Late pass.
     candidates_.clear();
     refresh_.clear();
     triangleTests_.clear();
-    const bool raster = params_.features.useBatchedRaster && testing;
-    if (!(root == NodeRef{})) active_.push_back(root);
+    if (!(root == NodeRef{})) {
+        active_.push_back(root);
+        lateTraversal(f, testing, haveDepth, triangles);
+    }
+
+    // 4. The batched raster test, exact per pixel against the early pass's depth, for the
+    // parts the pyramid let through; then every part drawn after a test (early, or late
+    // after this one) against the final depth: one hidden there is not drawn early next
+    // frame (the first frame, which has no early set, would otherwise draw everything twice).
+    if (!candidates_.empty()) testCandidates(f, triangles);
+    if (!triangleTests_.empty()) testTriangles(f);
+    if (triangles) readDrawMarks(f);
+    if (!refresh_.empty()) testRefresh(f);
+    // A frame with no early depth (the first, or after everything turned hidden) had
+    // nothing to test the pyramid against, so only the final-depth tests measured what
+    // testing saves; without them the frame says nothing and the estimate stands.
+    if (testing && (drewEarly || !refresh_.empty() || triangles)) {
+        lastTestedFrame_ = f.index;
+        savedNs_ = double(culledTriangles_) * params_.tuning.costs.drawNsPerTriangle;
+    }
+}
+
+bool QueryScheduler::drawEarlySet(Frame& f) {
+    // lastTouchedFrame marks a part drawn here.
+    const std::uint32_t partsBefore = f.stats.partsDrawn;
     while (!active_.empty()) {
         const NodeRef ref = active_.back();
         active_.pop_back();
-        ++stats_->nodesVisited;
-        const Aabb box = tree_->worldBox(ref);
+        ++f.stats.nodesVisited;
+        if (f.frustum().outside(f.tree.worldBox(ref))) continue;
+        NodeHistory& h = history_.at(ref, f.objects);
+        if (!f.tree.isDrawable(ref)) {
+            pushChildren(f, ref);
+            continue;
+        }
+        if (h.lastVisible && h.lastVisibleFrame + 1 == f.index) {
+            f.note(ref, NodeState::VisibleHistory);  // drawn untested
+            drawNode(f, ref, false);
+            h.lastTouchedFrame = f.index;
+        }
+    }
+    return f.stats.partsDrawn > partsBefore;
+}
+
+void QueryScheduler::lateTraversal(Frame& f, bool testing, bool haveDepth, bool triangles) {
+    // Parts the pyramid cannot reject are either drawn at once or, with the batched raster
+    // test, collected in `candidates_` and tested exactly afterwards; the parts drawn early
+    // are collected in `refresh_` to be tested against the final depth.
+    const SceneObjects& objs = f.objects;
+    const bool raster = params_.features.useBatchedRaster && testing;
+    while (!active_.empty()) {
+        const NodeRef ref = active_.back();
+        active_.pop_back();
+        ++f.stats.nodesVisited;
+        const Aabb box = f.tree.worldBox(ref);
         NodeHistory& h = history_.at(ref, objs);
         // A part drawn in the early pass is still tested (for next frame) but was decided
         // there: its trace entry is the early one.
-        const bool drawnEarly = tree_->isDrawable(ref) && h.lastTouchedFrame == frame_;
+        const bool drawnEarly = f.tree.isDrawable(ref) && h.lastTouchedFrame == f.index;
         auto note = [&](NodeState state) {
-            if (!drawnEarly) trace(ref, box, state);
+            if (!drawnEarly) f.note(ref, box, state);
         };
-        if (frustum_.outside(box)) {
-            ++stats_->frustumCulled;
+        if (f.frustum().outside(box)) {
+            ++f.stats.frustumCulled;
             h.lastVisible = false;
             note(NodeState::FrustumCulled);
             continue;
@@ -142,133 +135,127 @@ void QueryScheduler::runTwoPhase() {
         const QueryVolume volume = ref.isSceneNode() || !params_.features.useTightVolumes
                                        ? QueryVolume::fromAabb(box)
                                        : objectNodeVolume(objs, ref, params_.tuning.volume, params_.tuning.autoVolumeSaving);
-        const bool inFront = projectVolumeDepth(volume, rect, nearest);
+        const bool inFront = f.screen.volumeDepth(volume, rect, nearest);
         bool certain = false;  // visible without any test (near plane, camera inside)
-        if (!inFront || box.contains(camera_.position)) {
-            ++stats_->visibleNearOrInside;
+        if (!inFront || box.contains(f.camera().position)) {
+            ++f.stats.visibleNearOrInside;
             certain = true;
         } else if (rect.empty()) {
-            ++stats_->frustumCulled;
+            ++f.stats.frustumCulled;
             h.lastVisible = false;
             note(NodeState::FrustumCulled);
             continue;
         } else if (haveDepth) {
-            ++stats_->depthTests;
+            ++f.stats.depthTests;
             if (pyramid_.occluded(rect, nearest)) {
-                ++stats_->queriesOccluded;
-                culledTriangles_ += subtreeTriangles(ref);
-                history_.recordAnswer(h, false, frame_);
+                ++f.stats.queriesOccluded;
+                culledTriangles_ += subtreeTriangles(f, ref);
+                history_.recordAnswer(h, false, f.index);
                 note(NodeState::Occluded);
                 continue;
             }
         }
         h.lastVisible = true;
-        h.lastVisibleFrame = frame_;
-        if (!tree_->isDrawable(ref)) {
+        h.lastVisibleFrame = f.index;
+        if (!f.tree.isDrawable(ref)) {
             note(certain ? NodeState::VisibleNear : NodeState::VisibleQueried);
-            pushChildren(ref);
+            pushChildren(f, ref);
         } else if (drawnEarly) {
             if (!raster || certain || triangles) continue;  // marks answer for it with triangles
             // Visibility history, as in Queries: a part that kept answering "visible" is
             // tested again only after the frames its answers earn. The cost model may
             // postpone it further, but not past history's longest postponement, so every
             // part is tested now and then and the rate of culling tests stays measured.
-            const std::uint32_t sinceAnswer = frame_ - h.lastQueryFrame;
+            const std::uint32_t sinceAnswer = f.index - h.lastQueryFrame;
             if (params_.features.useHistory && sinceAnswer <= history_.postponement(ref, h, params_.tuning.history)) {
-                ++stats_->skippedByHistory;
-            } else if (sinceAnswer <= params_.tuning.history.maxSkipFrames && !worthTesting(ref, rect, refreshOccludedRate_)) {
-                ++stats_->skippedByCost;
+                ++f.stats.skippedByHistory;
+            } else if (sinceAnswer <= params_.tuning.history.maxSkipFrames && !worthTesting(f, ref, rect, refreshOccludedRate_)) {
+                ++f.stats.skippedByCost;
             } else {
                 refresh_.push_back({ref, volume});
             }
-        } else if (raster && !certain && (worthTesting(ref, rect, candidateOccludedRate_) || exploring(ref))) {
+        } else if (raster && !certain && (worthTesting(f, ref, rect, candidateOccludedRate_) || exploring(ref))) {
             candidates_.push_back({ref, volume});
         } else {
-            if (raster && !certain) ++stats_->skippedByCost;
+            if (raster && !certain) ++f.stats.skippedByCost;
             note(certain ? NodeState::VisibleNear : testing && !raster ? NodeState::VisibleQueried : NodeState::VisibleCheaper);
-            drawNode(ref, false);
+            drawNode(f, ref, false);
         }
     }
 
-    // 4. The batched raster test, exact per pixel against the early pass's depth, for the
-    // parts the pyramid let through; then every part drawn after a test (early, or late
-    // after this one) against the final depth: one hidden there is not drawn early next
-    // frame (the first frame, which has no early set, would otherwise draw everything twice).
-    // The rates the cost model sees move a quarter of the way to each batch's answers.
-    auto learn = [](double& rate, const std::vector<QueryResult>& answers) {
-        const auto occluded = std::count(answers.begin(), answers.end(), QueryResult::Occluded);
-        rate += 0.25 * (double(occluded) / double(answers.size()) - rate);
-    };
-    if (!candidates_.empty()) {
-        rasterTest(candidates_);
-        learn(candidateOccludedRate_, rasterAnswers_);
-        for (std::size_t i = 0; i < candidates_.size(); ++i) {
-            const NodeRef ref = candidates_[i].ref;
-            NodeHistory& h = history_.at(ref, objs);
-            if (rasterAnswers_[i] == QueryResult::Occluded) {
-                ++stats_->queriesOccluded;
-                culledTriangles_ += subtreeTriangles(ref);
-                history_.recordAnswer(h, false, frame_);
-                trace(ref, tree_->worldBox(ref), NodeState::Occluded);
-            } else if (triangles && (worthTriangleTest(ref) || exploring(ref))) {
-                const LocalBspNode& n = objs.model(objs.modelOf(ref.object)).nodes[ref.node];
-                triangleTests_.push_back({ref, n.firstIndex, n.indexCount});
-            } else {
-                trace(ref, tree_->worldBox(ref), NodeState::VisibleQueried);
-                drawNode(ref, false);
-                if (!triangles) refresh_.push_back(candidates_[i]);  // may be hidden by parts drawn after it
-            }
+}
+
+namespace {
+/// The cost model's rate of "occluded" answers moves a quarter of the way to a batch's.
+void learnOccludedRate(double& rate, const std::vector<QueryResult>& answers) {
+    const auto occluded = std::count(answers.begin(), answers.end(), QueryResult::Occluded);
+    rate += 0.25 * (double(occluded) / double(answers.size()) - rate);
+}
+}  // namespace
+
+void QueryScheduler::testCandidates(Frame& f, bool triangles) {
+    const SceneObjects& objs = f.objects;
+    rasterTest(f, candidates_);
+    learnOccludedRate(candidateOccludedRate_, rasterAnswers_);
+    for (std::size_t i = 0; i < candidates_.size(); ++i) {
+        const NodeRef ref = candidates_[i].ref;
+        NodeHistory& h = history_.at(ref, objs);
+        if (rasterAnswers_[i] == QueryResult::Occluded) {
+            ++f.stats.queriesOccluded;
+            culledTriangles_ += subtreeTriangles(f, ref);
+            history_.recordAnswer(h, false, f.index);
+            f.note(ref, NodeState::Occluded);
+        } else if (triangles && (worthTriangleTest(f, ref) || exploring(ref))) {
+            const LocalBspNode& n = objs.model(objs.modelOf(ref.object)).nodes[ref.node];
+            triangleTests_.push_back({ref, n.firstIndex, n.indexCount});
+        } else {
+            f.note(ref, NodeState::VisibleQueried);
+            drawNode(f, ref, false);
+            if (!triangles) refresh_.push_back(candidates_[i]);  // may be hidden by parts drawn after it
         }
-    }
-    if (!triangleTests_.empty()) testTriangles();
-    if (triangles) readDrawMarks();
-    if (!refresh_.empty()) {
-        rasterTest(refresh_);
-        learn(refreshOccludedRate_, rasterAnswers_);
-        for (std::size_t i = 0; i < refresh_.size(); ++i) {
-            const bool visible = rasterAnswers_[i] != QueryResult::Occluded;
-            if (!visible) culledTriangles_ += subtreeTriangles(refresh_[i].ref);  // not drawn early next frame
-            history_.recordAnswer(history_.at(refresh_[i].ref, objs), visible, frame_);
-        }
-    }
-    // A frame with no early depth (the first, or after everything turned hidden) had
-    // nothing to test the pyramid against, so only the final-depth tests measured what
-    // testing saves; without them the frame says nothing and the estimate stands.
-    if (testing && (drewEarly || !refresh_.empty() || triangles)) {
-        lastTestedFrame_ = frame_;
-        savedNs_ = double(culledTriangles_) * params_.tuning.costs.drawNsPerTriangle;
     }
 }
 
-void QueryScheduler::testTriangles() {
-    const SceneObjects& objs = tree_->objects();
-    const auto t0 = Clock::now();
+void QueryScheduler::testRefresh(Frame& f) {
+    const SceneObjects& objs = f.objects;
+    rasterTest(f, refresh_);
+    learnOccludedRate(refreshOccludedRate_, rasterAnswers_);
+    for (std::size_t i = 0; i < refresh_.size(); ++i) {
+        const bool visible = rasterAnswers_[i] != QueryResult::Occluded;
+        if (!visible) culledTriangles_ += subtreeTriangles(f, refresh_[i].ref);  // not drawn early next frame
+        history_.recordAnswer(history_.at(refresh_[i].ref, objs), visible, f.index);
+    }
+}
+
+void QueryScheduler::testTriangles(Frame& f) {
+    const SceneObjects& objs = f.objects;
+    const auto t0 = SchedulerClock::now();
     triangleAnswers_.assign(triangleTests_.size(), QueryResult::Visible);
-    sink_->testParts(triangleTests_, triangleAnswers_);
-    stats_->triangleTests += static_cast<std::uint32_t>(triangleTests_.size());
-    stats_->triangleTestMs += msSince(t0);
+    f.sink.testParts(triangleTests_, triangleAnswers_);
+    f.stats.triangleTests += static_cast<std::uint32_t>(triangleTests_.size());
+    f.stats.triangleTestMs += msSince(t0);
     const auto occluded = std::count(triangleAnswers_.begin(), triangleAnswers_.end(), QueryResult::Occluded);
     triangleOccludedRate_ += 0.25 * (double(occluded) / double(triangleTests_.size()) - triangleOccludedRate_);
     for (std::size_t i = 0; i < triangleTests_.size(); ++i) {
         const NodeRef ref = triangleTests_[i].part;
         if (triangleAnswers_[i] == QueryResult::Occluded) {
-            ++stats_->queriesOccluded;
+            ++f.stats.queriesOccluded;
             culledTriangles_ += triangleTests_[i].indexCount / 3;
-            history_.recordAnswer(history_.at(ref, objs), false, frame_);
-            trace(ref, tree_->worldBox(ref), NodeState::Occluded);
+            history_.recordAnswer(history_.at(ref, objs), false, f.index);
+            f.note(ref, NodeState::Occluded);
         } else {
-            trace(ref, tree_->worldBox(ref), NodeState::VisibleQueried);
-            drawNode(ref, false);  // its draw mark says whether it stays visible
+            f.note(ref, NodeState::VisibleQueried);
+            drawNode(f, ref, false);  // its draw mark says whether it stays visible
         }
     }
 }
 
-void QueryScheduler::readDrawMarks() {
-    const SceneObjects& objs = tree_->objects();
-    const auto t0 = Clock::now();
+void QueryScheduler::readDrawMarks(Frame& f) {
+    const SceneObjects& objs = f.objects;
+    const auto t0 = SchedulerClock::now();
     triangleAnswers_.assign(markedDraws_.size(), QueryResult::Visible);
-    if (!markedDraws_.empty()) sink_->readDrawMarks(triangleAnswers_);
-    stats_->triangleTestMs += msSince(t0);
+    if (!markedDraws_.empty()) f.sink.readDrawMarks(triangleAnswers_);
+    f.stats.triangleTestMs += msSince(t0);
     // A draw that showed nothing was hidden by what was drawn before it, and stays hidden
     // (depth only grows nearer): not drawn early next frame. One that showed a sample may
     // have been covered later; it is drawn early and marked again.
@@ -276,29 +263,29 @@ void QueryScheduler::readDrawMarks() {
         const NodeRef ref = markedDraws_[i];
         const bool visible = triangleAnswers_[i] != QueryResult::Occluded;
         if (!visible) {
-            ++stats_->drawMarksHidden;
-            culledTriangles_ += subtreeTriangles(ref);
+            ++f.stats.drawMarksHidden;
+            culledTriangles_ += subtreeTriangles(f, ref);
         }
-        history_.recordAnswer(history_.at(ref, objs), visible, frame_);
+        history_.recordAnswer(history_.at(ref, objs), visible, f.index);
     }
-    marking_ = false;
+    f.marking = false;
 }
 
-bool QueryScheduler::worthTriangleTest(NodeRef ref) {
+bool QueryScheduler::worthTriangleTest(const Frame& f, NodeRef ref) {
     if (!params_.features.useCostModel) return true;
     const TestCosts& c = params_.tuning.costs;
-    const double triangles = double(subtreeTriangles(ref));
+    const double triangles = double(subtreeTriangles(f, ref));
     return triangleOccludedRate_ * triangles * c.drawNsPerTriangle > c.triangleTestNsPerPart + triangles * c.triangleTestNsPerTriangle;
 }
 
-bool QueryScheduler::worthTesting(NodeRef ref, const ScreenRect& rect, double occludedRate) {
+bool QueryScheduler::worthTesting(const Frame& f, NodeRef ref, const ScreenRect& rect, double occludedRate) {
     if (!params_.features.useCostModel) return true;
     const TestCosts& c = params_.tuning.costs;
-    return occludedRate * double(subtreeTriangles(ref)) * c.drawNsPerTriangle > c.testNsPerVolume + c.testNsPerPixel * rect.area();
+    return occludedRate * double(subtreeTriangles(f, ref)) * c.drawNsPerTriangle > c.testNsPerVolume + c.testNsPerPixel * rect.area();
 }
 
-std::uint64_t QueryScheduler::subtreeTriangles(NodeRef ref) {
-    const SceneObjects& objs = tree_->objects();
+std::uint64_t QueryScheduler::subtreeTriangles(const Frame& f, NodeRef ref) {
+    const SceneObjects& objs = f.objects;
     auto objectTriangles = [&](std::uint32_t object, std::uint32_t node) {
         const LocalBsp& model = objs.model(objs.modelOf(object));
         // A bounds model's one part is the game's whole object: count what drawing it costs.
@@ -306,7 +293,7 @@ std::uint64_t QueryScheduler::subtreeTriangles(NodeRef ref) {
         return std::uint64_t{model.nodes[node].indexCount / 3};
     };
     if (!ref.isSceneNode()) return objectTriangles(ref.object, ref.node);
-    const LooseBsp& scene = tree_->scene();
+    const LooseBsp& scene = f.tree.scene();
     std::uint64_t triangles = 0;
     scratchIndices_.assign(1, ref.node);
     while (!scratchIndices_.empty()) {
@@ -324,18 +311,18 @@ bool QueryScheduler::exploring(NodeRef ref) const {
     return ((hashNode(ref) >> 5) + frame_) % 8 == 0;
 }
 
-void QueryScheduler::rasterTest(const std::vector<TestedPart>& parts) {
-    const auto t0 = Clock::now();
+void QueryScheduler::rasterTest(Frame& f, const std::vector<TestedPart>& parts) {
+    const auto t0 = SchedulerClock::now();
     rasterVolumes_.clear();
     for (const TestedPart& p : parts) rasterVolumes_.push_back(p.volume);
     rasterAnswers_.assign(parts.size(), QueryResult::Visible);
-    const BatchId batch = backend_->testVolumes(rasterVolumes_);
+    const BatchId batch = f.backend.testVolumes(rasterVolumes_);
     if (batch != kNoBatch) {
-        backend_->collectVolumes(batch, rasterAnswers_, params_.tuning.queryTimeoutMs);  // nothing else to do meanwhile
-        ++stats_->rasterBatches;
-        stats_->rasterTests += static_cast<std::uint32_t>(parts.size());
+        f.backend.collectVolumes(batch, rasterAnswers_, params_.tuning.queryTimeoutMs);  // nothing else to do meanwhile
+        ++f.stats.rasterBatches;
+        f.stats.rasterTests += static_cast<std::uint32_t>(parts.size());
     }
-    stats_->rasterMs += msSince(t0);
+    f.stats.rasterMs += msSince(t0);
 }
 
 }  // namespace dyncull

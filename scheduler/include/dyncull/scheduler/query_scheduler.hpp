@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -219,9 +220,16 @@ QueryVolume objectNodeVolume(const SceneObjects& objects, NodeRef ref, VolumeCho
 
 /// Runs one frame of culling and drawing. Owns the visibility history between frames;
 /// borrows the tree, backend and sink for the duration of cullFrame.
+class QueryIssuer;
+class DeferredQueries;
+class DrawQueries;
+
 class QueryScheduler {
 public:
     explicit QueryScheduler(SchedulerParams params = {});
+    ~QueryScheduler();
+    QueryScheduler(QueryScheduler&&) noexcept;
+    QueryScheduler& operator=(QueryScheduler&&) noexcept;
 
     const SchedulerParams& params() const { return params_; }
     void setParams(const SchedulerParams& p) { params_ = p; }
@@ -243,85 +251,90 @@ public:
     void setTrace(std::vector<NodeTrace>* trace) { trace_ = trace; }
     std::uint32_t frameIndex() const { return frame_; }
 
+    /// One frame's borrowed state, passed through every stage (cull_frame.hpp).
+    struct Frame;
+
 private:
-    struct Pending {
-        NodeRef node;
-        QueryId id;
-        ScreenRect rect;
-        bool batchedRect;  // rect is marked in pendingMap_
-        /// Generation of node.object when the query was issued: an answer that arrives after
-        /// the object was removed, and its slot perhaps reused by another model, is dropped.
-        std::uint32_t generation = 0;
-    };
-    /// A pending query of `ref`, stamped with its object's current generation.
-    Pending pendingOf(NodeRef ref, QueryId id, ScreenRect rect, bool batchedRect) const;
+    // Stages shared by the modes (query_scheduler.cpp).
     enum class FirstTest : std::uint8_t { Invisible, Visible, NeedQuery };
+    /// Algorithm 3: frustum, near plane, front-most leaves, small features, history.
+    FirstTest firstVisibilityTest(Frame& f, NodeRef ref, const Aabb& box, NodeHistory& h);
+    struct Visit {
+        NodeRef ref;
+        Aabb box;  // world space
+        FirstTest test;
+    };
+    /// Pops the nearest node off active_ and runs the first visibility test on it.
+    Visit visitNearest(Frame& f);
+    /// Algorithm 4: draws part `ref` or pushes its children. `untested`: decided visible
+    /// without a query this frame (gets a draw query).
+    void processVisible(Frame& f, NodeRef ref, NodeHistory& h, bool untested);
+    void drawNode(Frame& f, NodeRef ref, bool untested);
+    /// Pushes `ref`'s children front to back onto active_ (the nearest on top), leaving out
+    /// objects with a role, which the traversal never reaches (object_roles.cpp).
+    void pushChildren(Frame& f, NodeRef ref);
+    /// The volume Queries tests `ref` with: its world box, or once its object is still
+    /// (tightenAfterFrames) its own volume.
+    QueryVolume queryVolume(const Frame& f, NodeRef ref, const Aabb& worldBox) const;
+    /// Notes when `ref`'s object last changed its transform (for tightenAfterFrames).
+    void notePlacement(const Frame& f, NodeRef ref);
+    std::uint32_t countFrustumLeaves(const Frame& f) const;
 
-    FirstTest firstVisibilityTest(NodeRef ref, const Aabb& box, NodeHistory& h, FrameStats& st);
-    /// `untested`: decided visible without a query this frame (gets a draw query).
-    void processVisible(NodeRef ref, NodeHistory& h, bool untested);
-    void drawNode(NodeRef ref, bool untested);
-    /// Records last frame's draw-query answers that have arrived (non-blocking).
-    void collectDrawAnswers();
-    QueryVolume queryVolume(NodeRef ref, const Aabb& worldBox) const;
-    bool projectRect(const Aabb& box, ScreenRect& out) const;
-    /// Normalised-device bounds [lo, hi] as viewport pixels, rounded outwards, padded by one.
-    ScreenRect pixelRect(const glm::dvec2& lo, const glm::dvec2& hi) const;
-    void finishQuery(Pending& p, QueryResult r);
-
-    void timedBeginBatch();
-    void timedEndBatch();
-    QueryId timedIssue(const QueryVolume& volume);  // also counts its triangles
-    QueryResult timedPoll(QueryId id);
-    std::uint32_t countFrustumLeaves() const;
-    void runVfc();
-    void runSimple();
-    void runQueries();
-    void runTwoPhase();  // two_phase.cpp
+    // The modes.
+    void runVfc(Frame& f);
+    void runSimple(Frame& f);
+    void runQueries(Frame& f);   // hardware_queries.cpp
+    void runTwoPhase(Frame& f);  // two_phase.cpp
     // Objects with an OcclusionRole (object_roles.cpp): occluder-only ones drawn before the
     // mode's traversal, occludee-only ones tested against the final depth and drawn after.
-    void drawOccluders();
-    void drawOccludees();
-    /// Pushes `ref`'s children front to back onto active_ (the nearest on top), leaving out
-    /// objects with a role, which the traversal never reaches.
-    void pushChildren(NodeRef ref);
-    std::vector<std::pair<float, std::uint32_t>> roleOrder_;  // (distance, slot), per frame
-    /// A query volume's screen rectangle and nearest window depth (reversed Z: the largest
-    /// of its points'), the volume grown by its vertices' rounding first; false if it
-    /// reaches the near plane (then it is simply visible).
-    bool projectVolumeDepth(const QueryVolume& volume, ScreenRect& rect, float& nearestDepth) const;
+    void drawOccluders(Frame& f);
+    void drawOccludees(Frame& f);
+
+    // Queries' stages (hardware_queries.cpp).
+    /// A node that needs a query: accepted by the occupancy map, issued, or made to wait.
+    void queryOrWait(Frame& f, NodeRef ref, const Aabb& box, NodeHistory& h);
+    /// The occupancy-map fast accept: a rectangle touching screen where nothing has been
+    /// drawn cannot be hidden; draws the node and returns true.
+    bool acceptByOccupancy(Frame& f, NodeRef ref, const Aabb& box, const ScreenRect& rect);
+    /// The one-frame-latency setting: decides by the node's previous answer at once and
+    /// issues a query to be read in a later frame.
+    void decideByLastAnswer(Frame& f, NodeRef ref, const Aabb& box, NodeHistory& h);
+    /// Records a query's answer and draws or culls its node.
+    void finishQuery(Frame& f, NodeRef ref, QueryResult r);
+    /// Issues queries for waiting nodes, nearest first, that can now be issued; true if any was.
+    bool retryWaiting(Frame& f);
+    /// Records the answers of the latency setting's queries that have arrived (non-blocking).
+    void collectLatent(Frame& f);
 
     SchedulerParams params_;
     VisibilityHistory history_;
-    OccupancyMap drawnMap_, pendingMap_, waitingMap_;  // waiting: rects of nodes deferred this frame
     std::uint32_t frame_ = 0;
-    std::uint32_t frontBudget_ = 0, frontLeavesSeen_ = 0;  // frontPercent, this frame
     std::vector<std::uint32_t> stillSince_;  // per object slot: first frame of its current transform (seen lazily)
     std::vector<std::uint64_t> lastPlacement_;  // per object slot: SceneObjects::placedAt when last seen
+    std::vector<NodeTrace>* trace_ = nullptr;  // the caller's, between setTrace calls
 
-    // Per-frame borrowed state.
-    const TwoLevelTree* tree_ = nullptr;
-    QueryBackend* backend_ = nullptr;
-    PartSink* sink_ = nullptr;
-    Camera camera_;
-    glm::dmat4 viewProj_{1.0};  // camera-relative (Camera::viewProjectionRelativeDouble)
-    glm::dvec4 distanceRow_{0.0};  // Camera::distanceRowRelative
-    /// The distance along the view direction of eye-relative point `rel` whose clip
-    /// coordinates are `clip`: clip w in perspective, along distanceRow_ in orthographic.
-    double viewDistance(const glm::dvec4& clip, const glm::dvec3& rel) const {
-        return camera_.orthographic() ? glm::dot(distanceRow_, glm::dvec4(rel, 1.0)) : clip.w;
-    }
-    Frustum frustum_;
-    int width_ = 0, height_ = 0;
-    FrameStats* stats_ = nullptr;
-    std::vector<NodeRef> active_;   // stack: back() is the nearest unprocessed node
-    std::vector<Pending> pending_;
+    // Buffers reused across frames (their contents live for one frame).
+    std::vector<NodeRef> active_;  // stack: back() is the nearest unprocessed node
     std::vector<NodeRef> scratch_;
-    std::vector<NodeTrace>* trace_ = nullptr;
-    // useLastFrameResults: queries issued in an earlier frame, read when they answer.
-    std::vector<Pending> latent_;
-    // TwoPhase: the early pass's depth and its pyramid, reused across frames; the parts
-    // for the batched raster test and its answers.
+    std::vector<std::pair<float, std::uint32_t>> roleOrder_;  // (distance, slot)
+
+    // Queries. The occupancy maps of drawn rectangles and of waiting nodes' rectangles;
+    // the queries awaited this frame; nodes waiting to be queried, nearest first.
+    OccupancyMap drawnMap_, waitingMap_;
+    struct Waiting {
+        float dist2;  // squared distance from the eye to the box centre
+        NodeRef ref;
+        Aabb box;
+        ScreenRect rect;
+    };
+    std::vector<Waiting> waiting_;
+    bool answeredSinceRetry_ = false;  // a query finished since waiting nodes were last retried
+    std::unique_ptr<QueryIssuer> queries_;
+    std::unique_ptr<DeferredQueries> latent_;  // useLastFrameResults: read when they answer
+    std::unique_ptr<DrawQueries> drawQueries_;  // useDrawQueries
+
+    // TwoPhase (two_phase.cpp): the early pass's depth and its pyramid, reused across
+    // frames; the parts for the batched raster test and its answers.
     std::vector<float> depth_;
     DepthPyramid pyramid_;
     struct TestedPart {
@@ -335,55 +348,51 @@ private:
     double candidateOccludedRate_ = 0.5, refreshOccludedRate_ = 0.5, triangleOccludedRate_ = 0.5;
     // useTriangleTests: this frame's marked draws in order, the parts to test on their
     // triangles, and the answers of either.
-    bool marking_ = false;
     std::vector<NodeRef> markedDraws_;
     std::vector<PartRange> triangleTests_;
     std::vector<QueryResult> triangleAnswers_;
+    /// The early pass: last frame's visible parts drawn, frustum-culled; true if any was.
+    bool drawEarlySet(Frame& f);
+    /// The late pass: every node tested against the pyramid (if `haveDepth`), the parts it
+    /// lets through collected for the raster test (if this frame is `testing`) or drawn.
+    void lateTraversal(Frame& f, bool testing, bool haveDepth, bool triangles);
+    /// The batched raster test of candidates_, drawing the visible ones (or sending them
+    /// on to triangle tests).
+    void testCandidates(Frame& f, bool triangles);
+    /// refresh_ tested against the final depth: a part hidden there is not drawn early next frame.
+    void testRefresh(Frame& f);
     /// True if a triangle test of `ref` is expected to save more drawing than it costs.
-    bool worthTriangleTest(NodeRef ref);
+    bool worthTriangleTest(const Frame& f, NodeRef ref);
     /// Tests triangleTests_ (PartSink::testParts), draws the visible ones, records the answers.
-    void testTriangles();
+    void testTriangles(Frame& f);
     /// Reads this frame's draw marks into each drawn part's history.
-    void readDrawMarks();
+    void readDrawMarks(Frame& f);
     /// The drawing (ns) that the last frame with tests saved, and that frame's number.
     double savedNs_ = 1e300;
     std::uint32_t lastTestedFrame_ = 0;
     std::uint64_t culledTriangles_ = 0;  // this frame, by the pyramid and the raster tests
     /// Triangles under `ref`: its subtree's for an object node, its objects' for a scene node.
-    std::uint64_t subtreeTriangles(NodeRef ref);
+    std::uint64_t subtreeTriangles(const Frame& f, NodeRef ref);
     std::vector<std::uint32_t> scratchIndices_;  // subtreeTriangles' stack
     /// True if testing part `ref`, whose volume covers `rect`, is expected to save more
     /// drawing than it costs, given that a fraction `occludedRate` of such tests cull.
-    bool worthTesting(NodeRef ref, const ScreenRect& rect, double occludedRate);
+    bool worthTesting(const Frame& f, NodeRef ref, const ScreenRect& rect, double occludedRate);
     /// True for the new parts tested this frame whatever the cost model expects.
     bool exploring(NodeRef ref) const;
-    // useClusters (cluster_culling.cpp): the ranges of the part being drawn, whether the
-    // pyramid holds this frame's early depth, and per model the measured fraction of
-    // tested triangles that the cluster tests culled (a moving average).
-    std::vector<IndexRange> clusterRanges_;
-    bool clusterPyramid_ = false;
-    std::vector<double> clusterCulledRate_;
-    /// Tests the clusters of part `ref` (node `n` of `model`) where they may pay, leaving
-    /// the survivors in clusterRanges_ (adjacent ones merged); false if the part is to be
-    /// drawn whole.
-    bool cullClusters(NodeRef ref, const LocalBsp& model, const LocalBspNode& n);
     std::vector<QueryVolume> rasterVolumes_;
     std::vector<QueryResult> rasterAnswers_;
     /// One batched raster test of `parts`' volumes, answers in rasterAnswers_ (all Visible
     /// if the backend has no such test), waiting for them: nothing else is left to do.
-    void rasterTest(const std::vector<TestedPart>& parts);
-    // useDrawQueries: this frame's draw queries, and last frame's not yet read.
-    std::vector<Pending> drawQueries_, drawAnswers_;
+    void rasterTest(Frame& f, const std::vector<TestedPart>& parts);
 
-    void trace(NodeRef ref, const Aabb& box, NodeState s) {
-        if (trace_) trace_->push_back({ref, box, s});
-    }
-    /// Records the answers of latent_ that have arrived (non-blocking).
-    void collectLatent();
-    /// Polls `queries` (issued in earlier frames) without blocking: each answered one is
-    /// released and removed, and onAnswer(history, result) runs if its node still exists.
-    template <class OnAnswer>
-    void takeAnswered(std::vector<Pending>& queries, OnAnswer onAnswer);
+    // useClusters (cluster_culling.cpp): the ranges of the part being drawn, and per model
+    // the measured fraction of tested triangles that the cluster tests culled (a moving average).
+    std::vector<IndexRange> clusterRanges_;
+    std::vector<double> clusterCulledRate_;
+    /// Tests the clusters of part `ref` (node `n` of `model`) where they may pay, leaving
+    /// the survivors in clusterRanges_ (adjacent ones merged); false if the part is to be
+    /// drawn whole.
+    bool cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, const LocalBspNode& n);
 };
 
 }  // namespace dyncull

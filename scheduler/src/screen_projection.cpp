@@ -1,0 +1,102 @@
+// Conservative screen footprints (screen_projection.hpp): camera-relative, in double.
+#include "screen_projection.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace dyncull {
+
+bool ScreenProjection::rect(const Aabb& box, ScreenRect& out) const {
+    // Project the box clipped to the near plane, so boxes crossing it still get a correct
+    // (conservative) rectangle. Returns false if the box crosses the near plane.
+    // Double and camera-relative: the near test compares distances along the view direction
+    // directly (clip w in perspective) (no depth terms of the projection,
+    // which at near 1e-4 and far 1e7 span 11 orders of magnitude).
+    const glm::dvec3 eye(view_.camera.position);
+    const glm::dvec3 lo3 = glm::dvec3(box.min) - eye, hi3 = glm::dvec3(box.max) - eye;
+    // A box this close to the near plane counts as crossing it: the GPU clips a query
+    // volume with float vertices relative to the eye, which a backend may also push out by
+    // up to 2^-22 of its world coordinates (QueryBackend::issue).
+    // 2^-21 of the box's and 2^-22 of the eye-relative magnitude (and of near) cover both
+    // roundings with a factor of two to spare.
+    auto magnitude = [](const glm::dvec3& a, const glm::dvec3& b) {
+        const glm::dvec3 m = glm::max(glm::abs(a), glm::abs(b));
+        return std::max({m.x, m.y, m.z});
+    };
+    const double nearPlane = double(view_.camera.nearPlane);
+    const double nearTest = nearPlane + 0x1p-21 * magnitude(glm::dvec3(box.min), glm::dvec3(box.max)) +
+                            0x1p-22 * (magnitude(lo3, hi3) + nearPlane);
+    glm::dvec4 clip[8];
+    double distance[8];  // along the view direction
+    bool front[8];  // in front of the near plane itself: part of the rectangle
+    bool crosses = false;
+    for (int i = 0; i < 8; ++i) {
+        const glm::dvec3 c((i & 1) ? hi3.x : lo3.x, (i & 2) ? hi3.y : lo3.y, (i & 4) ? hi3.z : lo3.z);
+        clip[i] = view_.viewProjRelative * glm::dvec4(c, 1.0);
+        distance[i] = viewDistance(clip[i], c);
+        front[i] = distance[i] >= nearPlane;
+        crosses |= distance[i] < nearTest;
+    }
+    glm::dvec2 lo(1e300), hi(-1e300);
+    auto addPoint = [&](const glm::dvec4& p) {
+        const glm::dvec2 ndc = glm::dvec2(p) / p.w;  // w >= near > 0 (perspective) or 1 for every point added
+        lo = glm::min(lo, ndc);
+        hi = glm::max(hi, ndc);
+    };
+    for (int i = 0; i < 8; ++i)
+        if (front[i]) addPoint(clip[i]);
+    {
+        // The 12 edges: pairs of corners differing in exactly one bit, cut at the near plane.
+        for (int i = 0; i < 8; ++i)
+            for (int bit = 1; bit < 8; bit <<= 1) {
+                const int j = i | bit;
+                if (j == i || front[i] == front[j]) continue;
+                const double t = (distance[i] - nearPlane) / (distance[i] - distance[j]);
+                addPoint(clip[i] + (clip[j] - clip[i]) * t);
+            }
+    }
+    if (lo.x > hi.x) {  // nothing in front of the near plane
+        out = {};
+        return !crosses;
+    }
+    out = pixelRect(lo, hi);
+    return !crosses;
+}
+
+ScreenRect ScreenProjection::pixelRect(const glm::dvec2& lo, const glm::dvec2& hi) const {
+    // Pixels, rounded outwards and padded by one so rasterisation rules never leave a
+    // covered pixel outside the rectangle.
+    const double fx = 0.5 * view_.width, fy = 0.5 * view_.height;
+    auto clampi = [](double v, int lim) { return static_cast<int>(std::clamp(v, 0.0, static_cast<double>(lim))); };
+    return {clampi(std::floor((lo.x + 1.0) * fx) - 1.0, view_.width), clampi(std::floor((lo.y + 1.0) * fy) - 1.0, view_.height),
+            clampi(std::ceil((hi.x + 1.0) * fx) + 1.0, view_.width), clampi(std::ceil((hi.y + 1.0) * fy) + 1.0, view_.height)};
+}
+
+bool ScreenProjection::volumeDepth(const QueryVolume& volume, ScreenRect& rect, float& nearestDepth) const {
+    // The volume grown by the rounding of its float vertices, projected in double; any
+    // point within the near-plane margin makes it "crossing" (visible), as in projectRect.
+    std::array<glm::dvec3, QueryVolume::kMaxVertices> rel;
+    bool asBox = false;
+    const std::uint32_t n = volume.enlargedForRounding(glm::dvec3(view_.camera.position), rel, asBox);
+    double magnitude = 0.0;
+    for (std::uint32_t i = 0; i < n; ++i)
+        magnitude = std::max({magnitude, std::abs(rel[i].x), std::abs(rel[i].y), std::abs(rel[i].z)});
+    const double nearPlane = double(view_.camera.nearPlane);
+    const double nearTest = nearPlane + 0x1p-21 * magnitude + 0x1p-22 * nearPlane;
+    glm::dvec2 lo(1e300), hi(-1e300);
+    double nearest = 0.0;
+    for (std::uint32_t i = 0; i < n; ++i) {
+        const glm::dvec4 clip = view_.viewProjRelative * glm::dvec4(rel[i], 1.0);
+        if (viewDistance(clip, rel[i]) < nearTest) return false;
+        const glm::dvec2 ndc = glm::dvec2(clip) / clip.w;
+        lo = glm::min(lo, ndc);
+        hi = glm::max(hi, ndc);
+        nearest = std::max(nearest, clip.z / clip.w);
+    }
+    rect = pixelRect(lo, hi);
+    nearestDepth = static_cast<float>(nearest);
+    return true;
+}
+
+}  // namespace dyncull

@@ -1,0 +1,45 @@
+// Conservative screen footprints of boxes and query volumes: the pixel rectangle a volume
+// can touch and its nearest window depth, computed camera-relative in double, with the
+// near plane handled on purpose (a volume reaching it is "crossing", never projected).
+// Used by every mode's first visibility test, the depth-pyramid test and cluster culling.
+#pragma once
+
+#include <glm/glm.hpp>
+
+#include "dyncull/objects/aabb.hpp"
+#include "dyncull/objects/camera.hpp"
+#include "dyncull/scheduler/occupancy_map.hpp"
+#include "dyncull/scheduler/query_backend.hpp"
+
+namespace dyncull {
+
+/// Projects world-space boxes and volumes into one frame's viewport (pixels, origin at the
+/// lower left, as the occupancy maps and the depth pyramid count them). Borrows the view.
+class ScreenProjection {
+public:
+    explicit ScreenProjection(const FrameView& view) : view_(view), distanceRow_(view.camera.distanceRowRelative()) {}
+
+    /// The pixels world box `box` can touch, its part behind the near plane clipped away;
+    /// false if the box reaches the near plane (within the rounding a GPU's float clipping
+    /// may add), which makes it visible without a test. `out` is empty when nothing of the
+    /// box is in front of the near plane or on screen.
+    bool rect(const Aabb& box, ScreenRect& out) const;
+    /// A query volume's pixel rectangle and nearest window depth (reversed Z: the largest
+    /// of its points'), the volume grown by its vertices' rounding first; false if it
+    /// reaches the near plane (then it is simply visible).
+    bool volumeDepth(const QueryVolume& volume, ScreenRect& rect, float& nearestDepth) const;
+    /// Normalised-device bounds [lo, hi] as viewport pixels, rounded outwards, padded by one.
+    ScreenRect pixelRect(const glm::dvec2& lo, const glm::dvec2& hi) const;
+
+private:
+    /// The distance along the view direction of eye-relative point `rel` whose clip
+    /// coordinates are `clip`: clip w in perspective, along distanceRow_ in orthographic.
+    double viewDistance(const glm::dvec4& clip, const glm::dvec3& rel) const {
+        return view_.camera.orthographic() ? glm::dot(distanceRow_, glm::dvec4(rel, 1.0)) : clip.w;
+    }
+
+    const FrameView& view_;
+    glm::dvec4 distanceRow_;  // Camera::distanceRowRelative
+};
+
+}  // namespace dyncull
