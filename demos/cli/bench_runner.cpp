@@ -21,6 +21,15 @@ bool parseU32(const std::string& s, std::uint32_t& out) {
     return ec == std::errc() && p == s.data() + s.size();
 }
 
+/// "budget0.1" -> 0.1 for prefix "budget": a finite decimal in (0, 100].
+bool percentAfter(const std::string& name, const std::string& prefix, double& out) {
+    if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) return false;
+    const char* first = name.data() + prefix.size();
+    const char* last = name.data() + name.size();
+    const auto [p, ec] = std::from_chars(first, last, out, std::chars_format::fixed);
+    return ec == std::errc() && p == last && out > 0.0 && out <= 100.0;
+}
+
 /// "thr16" -> 16 for prefix "thr".
 bool numberAfter(const std::string& name, const std::string& prefix, std::uint32_t& out) {
     return name.size() > prefix.size() && name.compare(0, prefix.size(), prefix) == 0 &&
@@ -49,6 +58,15 @@ ModeSpec queriesMode(const std::string& name) {
 
 /// `full` and its ablations (two-phase), or false.
 bool applyTwoPhaseName(const std::string& part, ModeSpec& m) {
+    double budget = 0.0;
+    if (percentAfter(part, "budget", budget) || percentAfter(part, "budgetearly", budget)) {
+        // full with an error budget: culls visible parts while their samples fit in it.
+        // budgetearly: parts of the early set showing less than the budget handed to it.
+        m.scheduler.mode = CullMode::TwoPhase;
+        m.scheduler.approx.errorBudgetPercent = budget;
+        m.scheduler.approx.budgetEarlySet = part.compare(0, 11, "budgetearly") == 0;
+        return true;
+    }
     if (part != "full" && part != "full-hzb" && part != "full-nohist" && part != "full-nocost" && part != "full-tri" &&
         part != "full-noclusters")
         return false;
@@ -74,6 +92,7 @@ std::string modeNamesHelp() {
            "queries (hardware occlusion queries with history, batching and occupancy maps; the default before two-phase), oracle; "
            "ablations of full: full-hzb (the pyramid alone), full-tri (every part whose volume passes then tested on its own triangles, and draws marked), full-nohist (every part drawn early tested again each frame), full-nocost (every volume the pyramid lets through tested), full-noclusters (parts drawn whole, no cluster tests); "
            "vfc-noclusters (vfc drawing parts whole); "
+           "approximate full: budgetP (at most P percent of the frame's pixels lost, e.g. budget0.1), budgetearlyP (and early-set parts showing less than the budget handed to it); "
            "settings of queries: approximate thrN (pixel threshold), latency1 (last frame's results), "
            "skipN (history max skip N, 2 per visible), overlap (overlapping batches), smallN (small-feature pixels); "
            "backend: noflush (no glFlush after each batch); "
@@ -353,13 +372,16 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
             return Error{"frame " + std::to_string(frame) + ", mode " + spec.name + ": " + rendered.error().message};
         }
         row[m].stats = *rendered;
-        row[m].parts = compareParts(truth_, drawnLeaves(engine_.objects(), engine_.visibleParts()));
+        const std::vector<NodeRef> drawn = drawnLeaves(engine_.objects(), engine_.visibleParts());
+        row[m].parts = compareParts(truth_, drawn);
         images_[m] = engine_.renderer().readPixels();
-        auto diff = compareImages(images_[m], images_[0]);
+        auto diff = compareImages(images_[m], images_[0], &diffMask_);
         if (!diff) {
             return Error{diff.error().message};
         }
         row[m].image = *diff;
+        splitDifferingPixels(drawn, row[m]);
+        countPopIn(m, drawn, row[m]);
         if (!spec.oracle) row[m].falsePositiveCauses = falsePositiveCauses();
         if (m == 0 && measureBound_) {
             // vfc drew everything in the frustum: its depth buffer is the frame's final depth.
@@ -373,6 +395,28 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
     return {};
 }
 
+void BenchRunner::splitDifferingPixels(const std::vector<NodeRef>& drawn, ModeFrame& out) const {
+    // The ground truth's id image and the diff mask are both top-down, width x height.
+    const std::vector<std::uint32_t>& ids = groundTruth_->idImage();
+    const std::vector<NodeRef>& parts = groundTruth_->lastParts();
+    if (ids.size() != diffMask_.size()) return;  // sizes disagree: nothing to split by
+    for (std::size_t i = 0; i < diffMask_.size(); ++i) {
+        if (!diffMask_[i]) continue;
+        const std::uint32_t id = ids[i];
+        const bool lost = id != 0 && id <= parts.size() && !std::binary_search(drawn.begin(), drawn.end(), parts[id - 1]);
+        ++(lost ? out.lostPixels : out.tiedPixels);
+    }
+}
+
+void BenchRunner::countPopIn(std::size_t mode, const std::vector<NodeRef>& drawn, ModeFrame& out) {
+    if (missing_.size() < result_.modes.size()) missing_.resize(result_.modes.size());
+    std::vector<NodeRef>& missing = missing_[mode];
+    for (const NodeRef& p : missing)
+        if (std::binary_search(drawn.begin(), drawn.end(), p)) ++out.popIn;
+    missing.clear();
+    std::set_difference(truth_.parts.begin(), truth_.parts.end(), drawn.begin(), drawn.end(), std::back_inserter(missing));
+}
+
 FalsePositiveCauses BenchRunner::falsePositiveCauses() const {
     // Every leaf is decided once per frame, so each drawn leaf has one visible state.
     FalsePositiveCauses c;
@@ -383,7 +427,8 @@ FalsePositiveCauses BenchRunner::falsePositiveCauses() const {
             case NodeState::FrustumCulled:
             case NodeState::Occluded:
             case NodeState::SmallFeature:
-            case NodeState::ClusterCulled: break;
+            case NodeState::ClusterCulled:
+            case NodeState::BudgetCulled: break;
             case NodeState::VisibleQueried: ++c.queried; break;
             case NodeState::VisibleHistory: ++c.history; break;
             case NodeState::VisibleOccupancy: ++c.occupancy; break;

@@ -78,6 +78,12 @@ struct ModeFrame {
     FrameStats stats;
     PartErrors parts;   ///< against the ground-truth visible set
     ImageDiff image;    ///< against the vfc image of the same frame
+    /// The pixels unlike vfc's, split by the ground truth's part at each: `lostPixels` where
+    /// that part was not drawn (what culling lost), `tiedPixels` where it was (a depth tie
+    /// drawn in another order, or background: no part was lost there).
+    std::uint64_t lostPixels = 0, tiedPixels = 0;
+    /// Pop-in: parts visible but not drawn in the previous frame that are drawn in this one.
+    std::uint32_t popIn = 0;
     FalsePositiveCauses falsePositiveCauses;  ///< parts.falsePositives by cause (scheduler modes)
 };
 
@@ -147,10 +153,17 @@ private:
     std::vector<NodeRef> oracleParts_;
     std::vector<NodeTrace> trace_;
     bool measureBound_ = false;
+    std::vector<std::vector<NodeRef>> missing_;  // per mode: last frame's visible parts not drawn
+    std::vector<std::uint8_t> diffMask_;         // reused per mode and frame
 
     /// Queries the volume of every part in the frustum against the depth buffer as it is.
     VolumeBound volumeBound(VolumeChoice volume);
     FalsePositiveCauses falsePositiveCauses() const;
+    /// Splits `out.image`'s differing pixels (diffMask_) into lost and tied by the ground
+    /// truth's part at each and whether it is among `drawn` (sorted).
+    void splitDifferingPixels(const std::vector<NodeRef>& drawn, ModeFrame& out) const;
+    /// Pop-in of `mode` this frame, given what it drew (sorted); remembers what it missed.
+    void countPopIn(std::size_t mode, const std::vector<NodeRef>& drawn, ModeFrame& out);
 };
 
 /// What `dyncull bench` and `dyncull sweep` share: scene, frames, size, output directory.

@@ -20,6 +20,7 @@ glm::vec4 nodeStateColour(NodeState s) {
         case NodeState::VisibleCheaper: return {0.80f, 0.55f, 1.00f, 1.0f};
         case NodeState::VisibleOccluder: return {0.55f, 0.35f, 0.20f, 1.0f};
         case NodeState::ClusterCulled: return {0.45f, 0.45f, 0.85f, 1.0f};
+        case NodeState::BudgetCulled: return {1.00f, 0.40f, 0.60f, 1.0f};
     }
     return {1, 1, 1, 1};
 }
@@ -74,12 +75,14 @@ void NodeBoxView::drawText(Engine& engine, const std::vector<std::string>& lines
         static const NodeState kShown[] = {NodeState::Occluded, NodeState::VisibleQueried, NodeState::VisibleHistory,
                                            NodeState::VisibleOccupancy, NodeState::VisibleNear, NodeState::VisibleFront,
                                            NodeState::VisibleVfc, NodeState::VisibleCheaper, NodeState::VisibleOccluder,
-                                           NodeState::ClusterCulled, NodeState::SmallFeature, NodeState::FrustumCulled};
+                                           NodeState::ClusterCulled, NodeState::BudgetCulled, NodeState::SmallFeature,
+                                           NodeState::FrustumCulled};
         static const char* const kLabel[] = {"occluded", "visible (queried)", "visible (history, no query)",
                                              "visible (occupancy, no query)", "visible (near/inside)",
                                              "visible (front-most, no query)", "in frustum (vfc mode)",
                                              "visible (cheaper drawn than tested)", "occluder-only (untested)",
-                                             "every cluster culled", "small feature", "frustum culled"};
+                                             "every cluster culled", "culled within the error budget", "small feature",
+                                             "frustum culled"};
         const int rowH = kLineAdvance * scale;
         const int n = static_cast<int>(std::size(kShown));
         const int swatch = kGlyphHeight * scale;

@@ -63,6 +63,11 @@ int findMode(const std::vector<ModeSummary>& summary, const std::string& name) {
     return -1;
 }
 
+ClaimCheck checkClaim(const ModeFrame& f) {
+    if (f.stats.claimUnbounded) return {};
+    return {f.parts.falseNegativePixels > f.stats.claimedErrorPixels, f.lostPixels > f.stats.claimedErrorPixels};
+}
+
 std::vector<ModeSummary> summarise(const BenchResult& r) {
     std::vector<ModeSummary> out(r.modes.size());
     for (std::size_t m = 0; m < r.modes.size(); ++m) {
@@ -103,6 +108,17 @@ std::vector<ModeSummary> summarise(const BenchResult& r) {
             s.rasterMs += f.stats.rasterMs;
             s.largestRegion = std::max(s.largestRegion, f.image.largestRegion);
             s.timeouts += f.stats.queriesTimedOut;
+            const double framePixels = std::max(1.0, double(r.width) * double(r.height));
+            const double claimed = 100.0 * double(f.stats.claimedErrorPixels) / framePixels;
+            s.claimedPctMean += claimed;
+            s.claimedPctMax = std::max(s.claimedPctMax, claimed);
+            s.lostPctMax = std::max(s.lostPctMax, 100.0 * double(f.lostPixels) / framePixels);
+            const ClaimCheck k = checkClaim(f);
+            s.framesOverClaimTruth += k.overTruth;
+            s.framesOverClaimImage += k.overImage;
+            s.framesUnbounded += f.stats.claimUnbounded;
+            s.tiedPixels += f.tiedPixels;
+            s.popIn += f.popIn;
         }
         if (ms.empty()) continue;
         const double n = static_cast<double>(ms.size());
@@ -111,7 +127,7 @@ std::vector<ModeSummary> summarise(const BenchResult& r) {
         for (double* v : {&s.traversalMs, &s.queryMs, &s.waitMs, &s.drawMs, &s.parts, &s.triangles, &s.queries, &s.occluded,
                           &s.skippedHistory, &s.skippedOccupancy, &s.batches, &s.pctWrongMean, &s.falsePositives, &s.fpQueried,
                           &s.fpHistory, &s.fpOccupancy, &s.fpOther, &s.drawQueries, &s.drawQueriesOccluded, &s.depthTests,
-                          &s.depthReadMs, &s.rasterTests, &s.rasterMs})
+                          &s.depthReadMs, &s.rasterTests, &s.rasterMs, &s.claimedPctMean, &s.popIn})
             *v /= n;
         std::sort(ms.begin(), ms.end());
         s.msMin = ms.front();
@@ -173,7 +189,7 @@ const char* frameStatsCsvHeader() {
            "skipped_history,skipped_occupancy,skipped_cost,visible_near,visible_front,frustum_culled,small_feature_culled,"
            "nodes_visited,batches,parts,triangles,query_triangles,draw_queries,draw_queries_occluded,draw_queries_late,"
            "depth_tests,ms_depth_read,raster_tests,raster_batches,ms_raster,triangle_tests,ms_triangle_test,draw_marks_hidden,"
-           "cluster_tests,clusters_culled,cluster_triangles_culled,ms_clusters";
+           "cluster_tests,clusters_culled,cluster_triangles_culled,ms_clusters,budget_culled,claimed_error_pixels,claim_unbounded";
 }
 
 void writeFrameStatsCsv(std::ostream& f, const FrameStats& s) {
@@ -185,7 +201,8 @@ void writeFrameStatsCsv(std::ostream& f, const FrameStats& s) {
       << s.drawQueriesOccluded << ',' << s.drawQueriesLate << ',' << s.depthTests << ',' << s.depthReadMs << ','
       << s.rasterTests << ',' << s.rasterBatches << ',' << s.rasterMs << ',' << s.triangleTests << ','
       << s.triangleTestMs << ',' << s.drawMarksHidden << ',' << s.clusterTests << ',' << s.clustersCulled << ','
-      << s.clusterTrianglesCulled << ',' << s.clusterMs;
+      << s.clusterTrianglesCulled << ',' << s.clusterMs << ',' << s.budgetCulled << ',' << s.claimedErrorPixels << ','
+      << (s.claimUnbounded ? 1 : 0);
 }
 
 Status writeFramesCsv(const BenchResult& r, const fs::path& path) {
@@ -195,7 +212,8 @@ Status writeFramesCsv(const BenchResult& r, const fs::path& path) {
       << ",visible_parts,frustum_parts,false_negatives,false_negative_pixels,false_positives,"
          "pixels_wrong,pixels_wrong_pct,largest_wrong_region,frame_update_ms,ground_truth_ms,ground_truth_artefact_pixels,"
          "false_positives_queried,false_positives_history,false_positives_occupancy,false_positives_other,"
-         "visible_triangles,bound_aabb_parts,bound_aabb_triangles,bound_auto_parts,bound_auto_triangles\n";
+         "visible_triangles,pixels_lost,pixels_tied,claimed_error_pct,over_claim_truth,over_claim_image,pop_in,"
+         "bound_aabb_parts,bound_aabb_triangles,bound_auto_parts,bound_auto_triangles\n";
     for (std::size_t i = 0; i < r.frames.size(); ++i) {
         const FrameTruth& t = r.truth[i];
         for (std::size_t m = 0; m < r.modes.size(); ++m) {
@@ -208,6 +226,10 @@ Status writeFramesCsv(const BenchResult& r, const fs::path& path) {
               << d.largestRegion << ',' << t.updateMs << ',' << t.groundTruthMs << ',' << t.artefactPixels << ',';
             const FalsePositiveCauses& c = r.frames[i][m].falsePositiveCauses;
             f << c.queried << ',' << c.history << ',' << c.occupancy << ',' << c.other << ',' << t.visibleTriangles;
+            const ModeFrame& mf = r.frames[i][m];
+            const ClaimCheck k = checkClaim(mf);
+            f << ',' << mf.lostPixels << ',' << mf.tiedPixels << ',' << 100.0 * double(mf.stats.claimedErrorPixels) / double(r.width * r.height)
+              << ',' << (k.overTruth ? 1 : 0) << ',' << (k.overImage ? 1 : 0) << ',' << mf.popIn;
             if (t.boundMeasured)
                 f << ',' << t.boundAabb.parts << ',' << t.boundAabb.triangles << ',' << t.boundAuto.parts << ','
                   << t.boundAuto.triangles << '\n';
@@ -227,7 +249,8 @@ Status writeSummaryCsv(const std::vector<ModeSummary>& summary, const fs::path& 
          "largest_wrong_region,timeouts,pareto,volume,pct_parts_culled,query_triangles,leaf_volume,"
          "leaf_surface_area,leaf_triangles_mean,leaf_triangles_max,paired_vs_best,false_positives_queried,"
          "false_positives_history,false_positives_occupancy,false_positives_other,draw_queries,draw_queries_occluded,"
-         "depth_tests,ms_depth_read,raster_tests,ms_raster\n";
+         "depth_tests,ms_depth_read,raster_tests,ms_raster,claimed_error_pct_mean,claimed_error_pct_max,"
+         "pixels_lost_pct_max,frames_over_claim_truth,frames_over_claim_image,frames_unbounded,pixels_tied,pop_in_per_frame\n";
     for (const ModeSummary& s : summary)
         f << s.name << ',' << s.frames << ',' << s.msMean << ',' << s.msMedian << ',' << s.msMin << ',' << s.msMax
           << ',' << s.traversalMs << ',' << s.queryMs << ',' << s.waitMs << ',' << s.drawMs << ',' << s.ratioVfc << ',' << s.ratioOracle
@@ -239,7 +262,9 @@ Status writeSummaryCsv(const std::vector<ModeSummary>& summary, const fs::path& 
           << (s.leaves.leaves ? static_cast<double>(s.leaves.triangles) / static_cast<double>(s.leaves.leaves) : 0.0)
           << ',' << s.leaves.maxTriangles << ',' << s.pairedVsBest << ',' << s.fpQueried << ',' << s.fpHistory << ','
           << s.fpOccupancy << ',' << s.fpOther << ',' << s.drawQueries << ',' << s.drawQueriesOccluded << ','
-          << s.depthTests << ',' << s.depthReadMs << ',' << s.rasterTests << ',' << s.rasterMs << '\n';
+          << s.depthTests << ',' << s.depthReadMs << ',' << s.rasterTests << ',' << s.rasterMs << ',' << s.claimedPctMean
+          << ',' << s.claimedPctMax << ',' << s.lostPctMax << ',' << s.framesOverClaimTruth << ',' << s.framesOverClaimImage
+          << ',' << s.framesUnbounded << ',' << s.tiedPixels << ',' << s.popIn << '\n';
     return closeChecked(f, path);
 }
 

@@ -46,7 +46,23 @@ struct ModeSummary {
     double pairedVsBest = 0;
     LeafVolumeTotals leaves;       ///< world-space leaf volumes at the last frame (leaves == 0: n/a)
     bool pareto = false;  ///< on the speed-accuracy Pareto front (the oracle never is: it is not a real mode)
+    // The approximate settings' claims against what was measured (ClaimCheck).
+    double claimedPctMean = 0, claimedPctMax = 0;  ///< claimed error, % of the frame's pixels
+    double lostPctMax = 0;                          ///< pixels lost (unlike vfc where the truth's part was not drawn), worst frame, %
+    std::uint32_t framesOverClaimTruth = 0;         ///< frames whose false-negative pixels exceeded the claim
+    std::uint32_t framesOverClaimImage = 0;         ///< frames whose lost pixels exceeded the claim
+    std::uint32_t framesUnbounded = 0;              ///< frames where a setting without a bound culled
+    std::uint64_t tiedPixels = 0;                   ///< pixels unlike vfc that no lost part explains (depth ties), summed
+    double popIn = 0;                               ///< per frame
 };
+
+/// One frame's claim checked against the two measures of what it lost.
+struct ClaimCheck {
+    bool overTruth = false;  ///< false-negative pixels (ground truth) above the claim
+    bool overImage = false;  ///< lost pixels (image against vfc, ties excluded) above the claim
+};
+/// Frames where a setting without a bound acted are never "over": they claim nothing.
+ClaimCheck checkClaim(const ModeFrame& f);
 
 std::vector<ModeSummary> summarise(const BenchResult& result);
 /// Index of the mode named `name`, or -1.

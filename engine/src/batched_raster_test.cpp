@@ -38,6 +38,14 @@ layout(std430, binding = 0) writeonly buffer Visible { uint visible[]; };
 flat in uint vVolume;
 void main() { visible[vVolume] = 1u; }
 )";
+// The error budget's variant: every passing fragment counted. Each pixel of a convex
+// volume is covered once by its front faces, so the count is the volume's visible pixels.
+const char* const kCountFs = R"(#version 450 core
+layout(early_fragment_tests) in;
+layout(std430, binding = 0) buffer Samples { uint samples[]; };
+flat in uint vVolume;
+void main() { atomicAdd(samples[vVolume], 1u); }
+)";
 
 }  // namespace
 
@@ -47,6 +55,9 @@ Expected<std::unique_ptr<BatchedRasterTest>> BatchedRasterTest::create(GlContext
     t->program_ = buildProgram(kVs, kFs, log);
     if (!t->program_) return Error{"batched raster test shader: " + log};
     t->locViewProj_ = glGetUniformLocation(t->program_, "uViewProj");
+    t->countProgram_ = buildProgram(kVs, kCountFs, log);
+    if (!t->countProgram_) return Error{"batched raster test's counting shader: " + log};
+    t->locCountViewProj_ = glGetUniformLocation(t->countProgram_, "uViewProj");
     glCreateBuffers(1, &t->vbo_);
     glCreateBuffers(1, &t->ibo_);
     glCreateVertexArrays(1, &t->vao_);
@@ -68,6 +79,7 @@ BatchedRasterTest::~BatchedRasterTest() {
     glDeleteBuffers(1, &vbo_);
     glDeleteBuffers(1, &ibo_);
     if (program_) glDeleteProgram(program_);
+    if (countProgram_) glDeleteProgram(countProgram_);
 }
 
 bool BatchedRasterTest::allocate(std::uint32_t buffer, std::size_t bytes, const char* what) {
@@ -77,7 +89,7 @@ bool BatchedRasterTest::allocate(std::uint32_t buffer, std::size_t bytes, const 
 }
 
 BatchId BatchedRasterTest::draw(std::span<const QueryVolume> volumes, const VolumeView& view,
-                                const glm::mat4& viewProjRelative, VolumeTestState& state) {
+                                const glm::mat4& viewProjRelative, VolumeTestState& state, bool count) {
     BatchId id;
     if (!free_.empty()) {
         id = free_.back();
@@ -90,6 +102,7 @@ BatchId BatchedRasterTest::draw(std::span<const QueryVolume> volumes, const Volu
     Batch& b = batches_[id];
     b.live = true;
     b.count = static_cast<std::uint32_t>(volumes.size());
+    b.counted = count;
     b.visibleUndrawn.assign(volumes.size(), 0);
 
     // Streams: each volume's points with its index, and its triangles.
@@ -133,8 +146,8 @@ BatchId BatchedRasterTest::draw(std::span<const QueryVolume> volumes, const Volu
     glGetInteger64i_v(GL_SHADER_STORAGE_BUFFER_START, 0, &ssboStart);
     glGetInteger64i_v(GL_SHADER_STORAGE_BUFFER_SIZE, 0, &ssboSize);
     state.enter();
-    glUseProgram(program_);
-    glUniformMatrix4fv(locViewProj_, 1, GL_FALSE, glm::value_ptr(viewProjRelative));
+    glUseProgram(count ? countProgram_ : program_);
+    glUniformMatrix4fv(count ? locCountViewProj_ : locViewProj_, 1, GL_FALSE, glm::value_ptr(viewProjRelative));
     glBindVertexArray(vao_);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, b.buffer);
     glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(indices_.size()), GL_UNSIGNED_INT, nullptr);
@@ -150,14 +163,16 @@ BatchId BatchedRasterTest::draw(std::span<const QueryVolume> volumes, const Volu
     return id;
 }
 
-void BatchedRasterTest::read(BatchId id, std::span<QueryResult> out) {
+void BatchedRasterTest::read(BatchId id, std::span<QueryResult> out, std::span<std::uint32_t> samples) {
     Batch& b = batches_[id];
-    assert(b.live && out.size() == b.visibleUndrawn.size());
+    assert(b.live && out.size() == b.visibleUndrawn.size() && (samples.empty() || samples.size() == out.size()));
     readback_.assign(b.visibleUndrawn.size(), 0);
     if (b.drawn)
         glGetNamedBufferSubData(b.buffer, 0, static_cast<GLsizeiptr>(std::size_t{4} * b.count), readback_.data());
     for (std::size_t i = 0; i < out.size(); ++i)
         out[i] = b.visibleUndrawn[i] || readback_[i] ? QueryResult::Visible : QueryResult::Occluded;
+    for (std::size_t i = 0; i < samples.size(); ++i)
+        samples[i] = b.visibleUndrawn[i] || (!b.counted && readback_[i]) ? kUnknownSamples : readback_[i];
     discard(id);
 }
 

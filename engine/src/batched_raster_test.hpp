@@ -19,7 +19,8 @@ class GlContext;
 namespace dyncull::detail {
 
 /// Owns a vertex and an index stream for the volumes, a program whose fragments mark
-/// `visible[volume]` in a storage buffer, and one such buffer per batch in flight. Needs
+/// `visible[volume]` in a storage buffer (and one that counts them there), and one such
+/// buffer per batch in flight. Needs
 /// the GL context current for its whole life. Knows nothing of when a batch is answered:
 /// GlQueryBackend brackets each draw with a query and reads a batch once it has answered.
 class BatchedRasterTest {
@@ -33,12 +34,14 @@ public:
     /// (Camera::viewProjectionRelative) against the bound framebuffer's depth, inside
     /// `state`. A volume reaching the near plane is marked visible without being drawn.
     /// On a failed allocation nothing is drawn and every volume is marked visible (the
-    /// error goes to the context's log). Returns the batch to read.
+    /// error goes to the context's log). With `count`, each volume's passing fragments
+    /// are counted, not just marked. Returns the batch to read.
     BatchId draw(std::span<const QueryVolume> volumes, const VolumeView& view, const glm::mat4& viewProjRelative,
-                 VolumeTestState& state);
+                 VolumeTestState& state, bool count = false);
     /// The answers of a drawn batch (waits for the draw if it has not finished), one per
-    /// volume in order, and frees the batch.
-    void read(BatchId id, std::span<QueryResult> out);
+    /// volume in order, and frees the batch. `samples` (empty, or one per volume): the
+    /// counts of a counted batch, kUnknownSamples where unknown (see QueryBackend::collectVolumes).
+    void read(BatchId id, std::span<QueryResult> out, std::span<std::uint32_t> samples = {});
     /// Frees a batch without reading it.
     void discard(BatchId id);
     std::uint32_t volumeCount(BatchId id) const { return batches_[id].count; }
@@ -59,11 +62,12 @@ private:
         std::uint32_t count = 0;
         std::vector<std::uint8_t> visibleUndrawn;  // answered Visible without drawing
         bool drawn = false;  // the draw was issued: `buffer` holds answers
+        bool counted = false;  // `buffer` holds sample counts, not marks
         bool live = false;
     };
     GlContext& context_;
-    std::uint32_t program_ = 0, vao_ = 0, vbo_ = 0, ibo_ = 0;
-    int locViewProj_ = -1;
+    std::uint32_t program_ = 0, countProgram_ = 0, vao_ = 0, vbo_ = 0, ibo_ = 0;
+    int locViewProj_ = -1, locCountViewProj_ = -1;
     std::vector<Batch> batches_;
     std::vector<BatchId> free_;
     // Reused per draw.

@@ -310,13 +310,13 @@ void GlQueryBackend::release(QueryId id) {
 
 std::uint64_t GlQueryBackend::samples(QueryId id) const { return queries_[id].samples; }
 
-BatchId GlQueryBackend::testVolumes(std::span<const QueryVolume> volumes) {
+BatchId GlQueryBackend::testVolumes(std::span<const QueryVolume> volumes, bool countSamples) {
     assert(!inBatch_ && !inDrawQuery_);
     // A query around the draw tells without blocking when the batch has been rasterised;
     // its slot goes through the same safe-reuse queue as any query (see free_).
     const QueryId q = startQuery();
     glBeginQuery(queries_[q].target, queries_[q].name);
-    const BatchId id = batches_->draw(volumes, *view_, viewProj_, *rasterState_);
+    const BatchId id = batches_->draw(volumes, *view_, viewProj_, *rasterState_, countSamples);
     glEndQuery(queries_[q].target);
     if (params_.flushAfterBatch) glFlush();
     if (batchQuery_.size() <= id) batchQuery_.resize(id + 1, kNoQuery);
@@ -324,7 +324,9 @@ BatchId GlQueryBackend::testVolumes(std::span<const QueryVolume> volumes) {
     return id;
 }
 
-bool GlQueryBackend::collectVolumes(BatchId id, std::span<QueryResult> out, double waitMs) {
+bool GlQueryBackend::collectVolumes(BatchId id, std::span<QueryResult> out, double waitMs,
+                                    std::span<std::uint32_t> samples) {
+    assert(samples.empty() || samples.size() == out.size());
     assert(id < batchQuery_.size() && batchQuery_[id] != kNoQuery);
     const QueryId q = batchQuery_[id];
     const QueryResult done = waitMs > 0 ? wait(q, waitMs) : poll(q);
@@ -332,8 +334,9 @@ bool GlQueryBackend::collectVolumes(BatchId id, std::span<QueryResult> out, doub
     if (done == QueryResult::NotReady) {
         batches_->discard(id);  // timed out: never cull, never stall forever
         std::fill(out.begin(), out.end(), QueryResult::Visible);
+        std::fill(samples.begin(), samples.end(), kUnknownSamples);
     } else {
-        batches_->read(id, out);
+        batches_->read(id, out, samples);
     }
     release(q);
     batchQuery_[id] = kNoQuery;

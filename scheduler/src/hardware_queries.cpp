@@ -32,6 +32,9 @@ void QueryScheduler::runQueries(Frame& f) {
     drawQueries_->collect(f, history_);
 
     auto onAnswer = [&](const PendingQuery& p, QueryResult r) {
+        // A query answers "occluded" with samples only under a sample threshold: those
+        // samples bound what the culled node would have shown (depth only grows nearer).
+        if (r == QueryResult::Occluded) f.stats.claimedErrorPixels += f.backend.samples(p.id);
         finishQuery(f, p.node, r);
         answeredSinceRetry_ = true;
     };
@@ -113,6 +116,7 @@ void QueryScheduler::decideByLastAnswer(Frame& f, NodeRef ref, const Aabb& box, 
     }
     if (h.answers > 0 && !h.lastVisible) {
         ++f.stats.queriesOccluded;
+        f.stats.claimUnbounded = true;  // an old answer bounds nothing about this frame
         f.note(ref, box, NodeState::Occluded);
         return;
     }

@@ -87,7 +87,7 @@ public:
 
     bool empty() const { return pending_.empty(); }
     /// Removes the answered queries, oldest first, calling onAnswer(PendingQuery, result)
-    /// for each (the query already released); true if any answered.
+    /// for each, then releasing it; true if any answered.
     template <class OnAnswer>
     bool takeAnswered(QueryScheduler::Frame& f, OnAnswer onAnswer) {
         bool any = false;
@@ -99,8 +99,8 @@ public:
             }
             const PendingQuery p = pending_[i];
             pending_.erase(pending_.begin() + static_cast<std::ptrdiff_t>(i));
+            onAnswer(p, r);  // before the release: the answer may read the query's samples
             finish(f, p);
-            onAnswer(p, r);
             any = true;
         }
         return any;
@@ -112,8 +112,8 @@ public:
         const PendingQuery p = pending_.front();
         const QueryResult r = f.wait(p.id, timeoutMs);
         pending_.erase(pending_.begin());
-        finish(f, p);
         onAnswer(p, r);
+        finish(f, p);
     }
 
 private:

@@ -39,6 +39,7 @@ const char* toString(NodeState s) {
         case NodeState::VisibleCheaper: return "visible_cheaper";
         case NodeState::VisibleOccluder: return "visible_occluder";
         case NodeState::ClusterCulled: return "cluster_culled";
+        case NodeState::BudgetCulled: return "budget_culled";
     }
     return "?";
 }
@@ -62,6 +63,8 @@ Status validateSchedulerParams(const SchedulerParams& p) {
     for (double c : {p.tuning.costs.drawNsPerTriangle, p.tuning.costs.testNsPerVolume, p.tuning.costs.testNsPerPixel, p.tuning.costs.depthReadNs,
                      p.tuning.costs.triangleTestNsPerPart, p.tuning.costs.triangleTestNsPerTriangle})
         if (!(c >= 0.0 && c < 1e12)) return Error{"costs must be finite and non-negative (nanoseconds)"};
+    if (!(p.approx.errorBudgetPercent >= 0.0 && p.approx.errorBudgetPercent <= 100.0))
+        return Error{"errorBudgetPercent must be in [0, 100] (percent of the frame's pixels)"};
     if (p.tuning.costs.probeFrames == 0) return Error{"costs.probeFrames must be at least 1"};
     return {};
 }
@@ -148,6 +151,7 @@ QueryScheduler::FirstTest QueryScheduler::firstVisibilityTest(Frame& f, NodeRef 
     if (params_.mode != CullMode::Queries) return FirstTest::NeedQuery;
     if (params_.approx.smallFeaturePixels > 0 && static_cast<std::uint32_t>(rect.area()) < params_.approx.smallFeaturePixels) {
         ++st.smallFeatureCulled;
+        st.claimedErrorPixels += static_cast<std::uint64_t>(rect.area());  // everything it could show is inside
         h.lastVisible = false;
         f.note(ref, box, NodeState::SmallFeature);
         return FirstTest::Invisible;

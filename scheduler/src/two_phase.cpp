@@ -195,12 +195,21 @@ void learnOccludedRate(double& rate, const std::vector<QueryResult>& answers) {
 
 void QueryScheduler::testCandidates(Frame& f, bool triangles) {
     const SceneObjects& objs = f.objects;
-    rasterTest(f, candidates_);
-    learnOccludedRate(candidateOccludedRate_, rasterAnswers_);
+    const bool budget = params_.approx.errorBudgetPercent > 0.0;
+    rasterTest(f, candidates_, budget);
+    budgetCulled_.assign(candidates_.size(), 0);
+    if (budget) spendErrorBudget(f);
+    learnOccludedRate(candidateOccludedRate_, rasterAnswers_);  // budget culls save drawing too
     for (std::size_t i = 0; i < candidates_.size(); ++i) {
         const NodeRef ref = candidates_[i].ref;
         NodeHistory& h = history_.at(ref, objs);
-        if (rasterAnswers_[i] == QueryResult::Occluded) {
+        if (budgetCulled_[i]) {
+            // Not visible next frame either, so it is tested again then.
+            ++f.stats.budgetCulled;
+            culledTriangles_ += subtreeTriangles(f, ref);
+            history_.recordAnswer(h, false, f.index);
+            f.note(ref, NodeState::BudgetCulled);
+        } else if (rasterAnswers_[i] == QueryResult::Occluded) {
             ++f.stats.queriesOccluded;
             culledTriangles_ += subtreeTriangles(f, ref);
             history_.recordAnswer(h, false, f.index);
@@ -218,10 +227,16 @@ void QueryScheduler::testCandidates(Frame& f, bool triangles) {
 
 void QueryScheduler::testRefresh(Frame& f) {
     const SceneObjects& objs = f.objects;
-    rasterTest(f, refresh_);
+    // With an error budget, a part that shows so little that the budget could take it is
+    // left out of next frame's early set, so that it is a candidate the budget may cull
+    // then (drawn this frame, it costs no error now).
+    const bool budget = params_.approx.errorBudgetPercent > 0.0 && params_.approx.budgetEarlySet;
+    const double budgetPixels = params_.approx.errorBudgetPercent / 100.0 * double(f.view.width) * double(f.view.height);
+    rasterTest(f, refresh_, budget);
     learnOccludedRate(refreshOccludedRate_, rasterAnswers_);
     for (std::size_t i = 0; i < refresh_.size(); ++i) {
-        const bool visible = rasterAnswers_[i] != QueryResult::Occluded;
+        const bool visible = rasterAnswers_[i] != QueryResult::Occluded &&
+                             !(budget && rasterSamples_[i] != kUnknownSamples && double(rasterSamples_[i]) <= budgetPixels);
         if (!visible) culledTriangles_ += subtreeTriangles(f, refresh_[i].ref);  // not drawn early next frame
         history_.recordAnswer(history_.at(refresh_[i].ref, objs), visible, f.index);
     }
@@ -311,14 +326,16 @@ bool QueryScheduler::exploring(NodeRef ref) const {
     return ((hashNode(ref) >> 5) + frame_) % 8 == 0;
 }
 
-void QueryScheduler::rasterTest(Frame& f, const std::vector<TestedPart>& parts) {
+void QueryScheduler::rasterTest(Frame& f, const std::vector<TestedPart>& parts, bool countSamples) {
     const auto t0 = SchedulerClock::now();
     rasterVolumes_.clear();
     for (const TestedPart& p : parts) rasterVolumes_.push_back(p.volume);
     rasterAnswers_.assign(parts.size(), QueryResult::Visible);
-    const BatchId batch = f.backend.testVolumes(rasterVolumes_);
+    rasterSamples_.assign(countSamples ? parts.size() : 0, kUnknownSamples);
+    const BatchId batch = f.backend.testVolumes(rasterVolumes_, countSamples);
     if (batch != kNoBatch) {
-        f.backend.collectVolumes(batch, rasterAnswers_, params_.tuning.queryTimeoutMs);  // nothing else to do meanwhile
+        // Nothing else to do meanwhile: wait.
+        f.backend.collectVolumes(batch, rasterAnswers_, params_.tuning.queryTimeoutMs, rasterSamples_);
         ++f.stats.rasterBatches;
         f.stats.rasterTests += static_cast<std::uint32_t>(parts.size());
     }

@@ -5,6 +5,9 @@
 // stalled query, on every frame. The oracle draws exactly the visible set and must match
 // too; a large pixel threshold must show up as false negatives (the measurement sees errors).
 // The same holds for queries with every query volume (AABB, PCA box, 14/18/26-DOP, auto).
+// The approximate settings are checked on the same swarm against what they claim: the
+// error budget, the sample threshold and small-feature culling never lose more pixels than
+// their claimed bound, and the budget never claims more than it was given.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -252,6 +255,53 @@ TEST_F(ConservativeSwarm, EveryQueryVolumeDrawsTheVfcImage) {
     EXPECT_LT(totals[kdop26].volume, totals[aabb].volume);
     EXPECT_LE(drawn[kdop26], drawn[aabb]);
     EXPECT_GT(meshTriangles[kdop26], meshTriangles[aabb]);
+    EXPECT_EQ(ctx->checkErrors(), 0u);
+}
+
+TEST_F(ConservativeSwarm, ApproximateSettingsNeverLoseMoreThanTheyClaim) {
+    ASSERT_NO_FATAL_FAILURE(build("dyncull_claims_", 24));
+
+    auto modes = cli::modesFromList("vfc,budget0.1,budget2,thr64,small2000,latency1");
+    ASSERT_TRUE(modes.ok()) << modes.error().message;
+    for (cli::ModeSpec& m : *modes) m.scheduler.tuning.queryTimeoutMs = 20000.0;
+    auto runner = cli::BenchRunner::create(*engine, *scene, modes.take());
+    ASSERT_TRUE(runner.ok()) << runner.error().message;
+    const auto& names = (*runner)->result().modes;
+    const double pixels = 320.0 * 180.0;
+
+    std::vector<std::uint64_t> claimed(names.size(), 0), lost(names.size(), 0), culled(names.size(), 0);
+    std::uint64_t unboundedFrames = 0;
+    for (std::uint64_t frame = 0; frame < bo.frames; ++frame) {
+        ASSERT_TRUE((*runner)->runFrame(frame).ok());
+        const auto& row = (*runner)->result().frames.back();
+        for (std::size_t m = 1; m < row.size(); ++m) {
+            SCOPED_TRACE(names[m].name + " frame " + std::to_string(frame));
+            const cli::ModeFrame& f = row[m];
+            claimed[m] += f.stats.claimedErrorPixels;
+            lost[m] += f.parts.falseNegativePixels;
+            culled[m] += f.stats.budgetCulled;
+            if (names[m].name == "latency1") {
+                // Last frame's answers bound nothing: such frames claim nothing either.
+                unboundedFrames += f.stats.claimUnbounded;
+                continue;
+            }
+            EXPECT_FALSE(f.stats.claimUnbounded);
+            // The claim bounds both measures of the loss: the ground truth's pixels of the
+            // parts not drawn, and the pixels unlike vfc where such a part is in front.
+            EXPECT_LE(f.parts.falseNegativePixels, f.stats.claimedErrorPixels);
+            EXPECT_LE(f.lostPixels, f.stats.claimedErrorPixels);
+            EXPECT_LE(f.lostPixels, f.image.differingPixels);
+        }
+        EXPECT_LE(double(row[1].stats.claimedErrorPixels), 0.001 * pixels);  // budget0.1
+        EXPECT_LE(double(row[2].stats.claimedErrorPixels), 0.02 * pixels);   // budget2
+    }
+    ASSERT_EQ(names[2].name, "budget2");
+    // The settings acted, or the bounds above prove nothing.
+    EXPECT_GT(culled[2], 0u) << "a 2% budget should cull some visible parts";
+    EXPECT_GT(lost[2], 0u) << "and lose some pixels doing so";
+    EXPECT_GE(culled[2], culled[1]);
+    for (std::size_t m = 1; m + 1 < names.size(); ++m) EXPECT_GT(claimed[m], 0u) << names[m].name;
+    EXPECT_GT(unboundedFrames, 0u) << "latency1 should cull on an old answer at least once";
     EXPECT_EQ(ctx->checkErrors(), 0u);
 }
 

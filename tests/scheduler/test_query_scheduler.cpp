@@ -905,15 +905,16 @@ struct DepthBackend final : QueryBackend {
         d.assign(std::size_t{640} * 320, depth);
         return true;
     }
-    BatchId testVolumes(std::span<const QueryVolume> volumes) override {
+    BatchId testVolumes(std::span<const QueryVolume> volumes, bool = false) override {
         tested += static_cast<int>(volumes.size());
         answers.emplace_back();
         for (const QueryVolume& v : volumes) answers.back().push_back(rule(v));
         return static_cast<BatchId>(answers.size() - 1);
     }
-    bool collectVolumes(BatchId id, std::span<QueryResult> out, double) override {
+    bool collectVolumes(BatchId id, std::span<QueryResult> out, double, std::span<std::uint32_t> samples = {}) override {
         EXPECT_EQ(out.size(), answers[id].size());
         std::copy(answers[id].begin(), answers[id].end(), out.begin());
+        std::fill(samples.begin(), samples.end(), kUnknownSamples);
         return true;
     }
 };

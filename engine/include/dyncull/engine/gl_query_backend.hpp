@@ -66,8 +66,8 @@ public:
     void setTarget(const FrameTarget& target) { target_ = target; hasTarget_ = true; }
     /// The batched raster test: one draw of all volumes into a visibility buffer, read
     /// back once its fence has signalled (batched_raster_test.cpp).
-    BatchId testVolumes(std::span<const QueryVolume> volumes) override;
-    bool collectVolumes(BatchId id, std::span<QueryResult> out, double waitMs) override;
+    BatchId testVolumes(std::span<const QueryVolume> volumes, bool countSamples = false) override;
+    bool collectVolumes(BatchId id, std::span<QueryResult> out, double waitMs, std::span<std::uint32_t> samples = {}) override;
 
     const GlQueryParams& params() const { return params_; }
     void setParams(const GlQueryParams& p) { params_ = p; }

@@ -39,6 +39,16 @@ struct FrameStats {
     std::uint32_t visibleFront = 0;  ///< visible without a query: front-most leaves (SchedulerTuning::frontPercent)
     std::uint32_t frustumCulled = 0;
     std::uint32_t smallFeatureCulled = 0;  ///< approximate small-feature setting
+    std::uint32_t budgetCulled = 0;  ///< two-phase: parts culled within the error budget (SchedulerApproximations)
+    /// What the approximate settings claim this frame lost: an upper bound on the pixels
+    /// showing something else than they would with every visible part drawn, summed over
+    /// the nodes culled approximately (each node's own bound: the samples its volume passed,
+    /// for the error budget and the sample threshold; its screen rectangle's area, for small
+    /// features). 0 for conservative settings.
+    std::uint64_t claimedErrorPixels = 0;
+    /// A setting without a bound culled something this frame (last frame's answers,
+    /// SchedulerApproximations::useLastFrameResults): claimedErrorPixels does not cover it.
+    bool claimUnbounded = false;
     std::uint32_t nodesVisited = 0;
     std::uint32_t batches = 0;
     /// Local-BSP leaves (object parts) drawn, whole or as the clusters that survived; a part

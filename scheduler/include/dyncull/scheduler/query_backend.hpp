@@ -68,6 +68,8 @@ using QueryId = std::uint32_t;
 inline constexpr QueryId kNoQuery = 0xffffffffu;
 
 using BatchId = std::uint32_t;
+/// A sample count that is not known (QueryBackend::collectVolumes): treat as "many".
+inline constexpr std::uint32_t kUnknownSamples = 0xffffffffu;
 /// Returned by a backend without the batched raster test (QueryBackend::testVolumes).
 inline constexpr BatchId kNoBatch = 0xffffffffu;
 
@@ -117,17 +119,24 @@ public:
     /// marks its volume visible. The answer rule is issue()'s (exact per pixel, enlarged
     /// volumes, a volume reaching the near plane is Visible), but hundreds of volumes cost
     /// one draw and one small readback. Outside a batch and a draw query. The volumes are
-    /// copied; kNoBatch if the backend cannot (the default).
-    virtual BatchId testVolumes(std::span<const QueryVolume> volumes) {
-        (void)volumes;
+    /// copied; kNoBatch if the backend cannot (the default). With `countSamples` each
+    /// volume's passing samples are counted too (collectVolumes' `samples`), which the
+    /// error budget needs; a count costs an atomic add per fragment instead of a store.
+    virtual BatchId testVolumes(std::span<const QueryVolume> volumes, bool countSamples = false) {
+        (void)volumes, (void)countSamples;
         return kNoBatch;
     }
     /// Collects a batch into `out` (one entry per volume, in order: Visible or Occluded)
     /// and releases it, returning true. With `waitMs` 0 it never blocks and returns false
     /// while the answer is not ready; with `waitMs` > 0 it waits that long and then answers
     /// every volume Visible (never cull, never stall forever). Every batch is collected once.
-    virtual bool collectVolumes(BatchId id, std::span<QueryResult> out, double waitMs) {
-        (void)id, (void)out, (void)waitMs;
+    /// `samples`, if not empty (one per volume), gets each volume's samples that passed the
+    /// depth test when the batch counted them: at least the pixels of anything inside the
+    /// volume that the depth drawn so far leaves visible. kUnknownSamples for a volume whose
+    /// count is unknown (not counted, reaching the near plane, not drawn, timed out).
+    virtual bool collectVolumes(BatchId id, std::span<QueryResult> out, double waitMs,
+                                std::span<std::uint32_t> samples = {}) {
+        (void)id, (void)out, (void)waitMs, (void)samples;
         return false;
     }
 };
