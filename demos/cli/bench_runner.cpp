@@ -254,7 +254,8 @@ Expected<std::vector<ModeSpec>> modesFromList(const std::string& list) {
 }
 
 std::string sweepParamsHelp() {
-    return "pixel-threshold, max-skip, skip-per-visible, small-feature, max-in-flight, tile-size, auto-saving (percent)";
+    return "pixel-threshold, max-skip, skip-per-visible, small-feature, max-in-flight, tile-size, auto-saving (percent); "
+           "error-budget (full; percent of the frame's pixels, decimals allowed)";
 }
 
 Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec) {
@@ -265,9 +266,16 @@ Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec) {
     std::vector<ModeSpec> out;
     for (const std::string& text : splitCommas(spec.substr(eq + 1))) {
         std::uint32_t v = 0;
-        if (!parseU32(text, v)) return Error{"--param " + param + ": '" + text + "' is not a non-negative integer"};
+        double percent = 0.0;
         ModeSpec m = queriesMode(param + "=" + text);
-        if (param == "pixel-threshold") {
+        if (param == "error-budget") {
+            if (!percentAfter("=" + text, "=", percent))
+                return Error{"--param error-budget: '" + text + "' is not a percentage in (0, 100]"};
+            m.scheduler.mode = CullMode::TwoPhase;
+            m.scheduler.approx.errorBudgetPercent = percent;
+        } else if (!parseU32(text, v)) {
+            return Error{"--param " + param + ": '" + text + "' is not a non-negative integer"};
+        } else if (param == "pixel-threshold") {
             m.queries.visiblePixelThreshold = v;
         } else if (param == "max-skip") {
             m.scheduler.tuning.history.maxSkipFrames = v;

@@ -68,6 +68,7 @@ void runRun(RunOptions o) {
     if (!mode) fail("--mode: " + mode.error().message);
     if (o.flags.volume != SchedulerFlags{}.volume && *mode != CullMode::TwoPhase && *mode != CullMode::Queries)
         fail("--volume: applies to --mode full and queries only");
+    if (o.flags.errorBudget > 0.0 && *mode != CullMode::TwoPhase) fail("--error-budget: applies to --mode full only");
     setCrashPhase("scene set-up");
     auto made = makeScene(o.scene, o.sceneOptions);
     if (!made) fail(made.error().message);

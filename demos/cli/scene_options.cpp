@@ -115,6 +115,11 @@ void addSchedulerOptions(CLI::App& cmd, SchedulerFlags& f) {
                    "cull nodes with at most this many visible samples (0 = conservative)")
         ->check(wholeIn(0, 1000000000))
         ->capture_default_str();
+    cmd.add_option("--error-budget", f.errorBudget,
+                   "full: cull visible parts while the pixels they can show stay within this percentage of the frame "
+                   "(the claim is in the stats; 0 = conservative)")
+        ->check(realIn(0.0, 100.0))
+        ->capture_default_str();
     cmd.add_option("--front-percent", f.frontPercent,
                    "simple/full: draw the front-most N% of the leaves in the frustum without queries (conservative)")
         ->check(realIn(0.0, 100.0))
@@ -132,6 +137,7 @@ SchedulerParams toParams(const SchedulerFlags& f, CullMode mode) {
     p.tuning.maxQueriesInFlight = f.maxInFlight;
     p.tuning.history.maxSkipFrames = f.maxSkip;
     p.tuning.frontPercent = f.frontPercent;
+    p.approx.errorBudgetPercent = f.errorBudget;
     p.tuning.volume = parseVolumeChoice(f.volume).value();  // checked by the option's IsMember
     p.tuning.autoVolumeSaving = f.autoSaving;
     return p;

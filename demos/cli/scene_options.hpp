@@ -46,6 +46,7 @@ struct SchedulerFlags {
     std::uint32_t maxInFlight = SchedulerParams{}.tuning.maxQueriesInFlight;
     std::uint32_t maxSkip = SchedulerParams{}.tuning.history.maxSkipFrames;
     std::uint32_t pixelThreshold = 0;
+    double errorBudget = 0.0;  ///< percent of the frame's pixels (full only; 0 = conservative)
     float frontPercent = 0.0f;
     std::string volume = "auto";  ///< one of aabb, obb, kdop14, kdop18, kdop26, auto (checked by CLI11)
     float autoSaving = SchedulerParams{}.tuning.autoVolumeSaving;
