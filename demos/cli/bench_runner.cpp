@@ -59,6 +59,13 @@ ModeSpec queriesMode(const std::string& name) {
 /// `full` and its ablations (two-phase), or false.
 bool applyTwoPhaseName(const std::string& part, ModeSpec& m) {
     double budget = 0.0;
+    if (percentAfter(part, "budgetrecount", budget)) {
+        // The error budget with the parts that could fit counted again, last: measured, off.
+        m.scheduler.mode = CullMode::TwoPhase;
+        m.scheduler.approx.errorBudgetPercent = budget;
+        m.scheduler.approx.budgetRecount = true;
+        return true;
+    }
     if (percentAfter(part, "budget", budget) || percentAfter(part, "budgetearly", budget)) {
         // full with an error budget: culls visible parts while their samples fit in it.
         // budgetearly: parts of the early set showing less than the budget handed to it.
@@ -92,7 +99,7 @@ std::string modeNamesHelp() {
            "queries (hardware occlusion queries with history, batching and occupancy maps; the default before two-phase), oracle; "
            "ablations of full: full-hzb (the pyramid alone), full-tri (every part whose volume passes then tested on its own triangles, and draws marked), full-nohist (every part drawn early tested again each frame), full-nocost (every volume the pyramid lets through tested), full-noclusters (parts drawn whole, no cluster tests); "
            "vfc-noclusters (vfc drawing parts whole); "
-           "approximate full: budgetP (at most P percent of the frame's pixels lost, e.g. budget0.1), budgetearlyP (and early-set parts showing less than the budget handed to it); "
+           "approximate full: budgetP (at most P percent of the frame's pixels lost, e.g. budget0.1), budgetearlyP (and early-set parts showing less than the budget handed to it), budgetrecountP (the parts that could fit drawn last, counted again against the depth of the rest); "
            "settings of queries: approximate thrN (pixel threshold), latency1 (last frame's results), "
            "skipN (history max skip N, 2 per visible), overlap (overlapping batches), smallN (small-feature pixels); "
            "backend: noflush (no glFlush after each batch); "

@@ -32,7 +32,9 @@ struct ModeSpec {
 };
 
 /// A named mode: vfc, simple, full (two-phase, the default), queries (hardware queries),
-/// oracle; ablations of full: full-hzb, full-nohist, full-nocost; settings of queries:
+/// oracle; ablations of full: full-hzb, full-nohist, full-nocost; approximate full:
+/// budgetP (error budget of P percent of the frame's pixels) and its variants budgetrecountP,
+/// budgetearlyP; settings of queries:
 /// approximate presets thrN (pixel threshold N), latency1 (last frame's results), skipN
 /// (history: max skip N, 2 frames per visible answer), overlap (overlapping batches),
 /// smallN (small-feature culling below N pixels); frontN (conservative: the front-most N%

@@ -1,6 +1,6 @@
 // The error budget: approximate culling with a bound on the pixels each frame loses.
-// A sample threshold (OpenSceneGraph's, Unreal's; the two-level paper's approximate
-// culling, section 3.5) culls what looks small and says nothing of the error. Here the
+// A sample threshold (OpenSceneGraph's, Unreal's) culls what looks small and says nothing
+// of the error; none of the papers this project follows bounds it either. Here the
 // batched raster test counts each candidate volume's samples that pass the early depth;
 // a volume covers at least the pixels its part shows, and the final depth is only nearer,
 // so the samples of the parts culled bound the pixels the frame loses. Those samples are
@@ -32,7 +32,7 @@ void QueryScheduler::spendErrorBudget(Frame& f) {
         const std::uint32_t samples = rasterSamples_[i];
         if (samples > budget - spent) continue;  // a smaller one further on may still fit
         spent += samples;
-        budgetCulled_[i] = 1;
+        budgetCulled_[i] = kBudgetCulled;
         rasterAnswers_[i] = QueryResult::Occluded;
     }
     f.stats.claimedErrorPixels = spent;

@@ -194,16 +194,47 @@ void learnOccludedRate(double& rate, const std::vector<QueryResult>& answers) {
 }  // namespace
 
 void QueryScheduler::testCandidates(Frame& f, bool triangles) {
-    const SceneObjects& objs = f.objects;
     const bool budget = params_.approx.errorBudgetPercent > 0.0;
     rasterTest(f, candidates_, budget);
-    budgetCulled_.assign(candidates_.size(), 0);
-    if (budget) spendErrorBudget(f);
-    learnOccludedRate(candidateOccludedRate_, rasterAnswers_);  // budget culls save drawing too
+    budgetCulled_.assign(candidates_.size(), kBudgetNo);
+    if (!budget) {
+        learnOccludedRate(candidateOccludedRate_, rasterAnswers_);
+        settleCandidates(f, triangles);
+        return;
+    }
+    if (!params_.approx.budgetRecount) {
+        spendErrorBudget(f);
+        learnOccludedRate(candidateOccludedRate_, rasterAnswers_);  // budget culls save drawing too
+        settleCandidates(f, triangles);
+        return;
+    }
+    // The candidates small enough to fit in the budget wait until the others are drawn,
+    // and are counted again against that nearer depth: they show fewer samples there
+    // (often none), so the same budget takes more of them.
+    const double budgetPixels = params_.approx.errorBudgetPercent / 100.0 * double(f.view.width) * double(f.view.height);
+    waitingParts_.clear();
+    for (std::size_t i = 0; i < candidates_.size(); ++i)
+        if (rasterAnswers_[i] != QueryResult::Occluded && double(rasterSamples_[i]) <= budgetPixels) {
+            budgetCulled_[i] = kBudgetLater;
+            waitingParts_.push_back(candidates_[i]);
+        }
+    learnOccludedRate(candidateOccludedRate_, rasterAnswers_);
+    settleCandidates(f, triangles);
+    if (waitingParts_.empty()) return;
+    candidates_.swap(waitingParts_);
+    rasterTest(f, candidates_, true);
+    budgetCulled_.assign(candidates_.size(), kBudgetNo);
+    spendErrorBudget(f);
+    settleCandidates(f, triangles);
+}
+
+void QueryScheduler::settleCandidates(Frame& f, bool triangles) {
+    const SceneObjects& objs = f.objects;
     for (std::size_t i = 0; i < candidates_.size(); ++i) {
         const NodeRef ref = candidates_[i].ref;
         NodeHistory& h = history_.at(ref, objs);
-        if (budgetCulled_[i]) {
+        if (budgetCulled_[i] == kBudgetLater) continue;
+        if (budgetCulled_[i] == kBudgetCulled) {
             // Not visible next frame either, so it is tested again then.
             ++f.stats.budgetCulled;
             culledTriangles_ += subtreeTriangles(f, ref);

@@ -54,7 +54,9 @@ TEST(BenchModes, PresetsSetOneThing) {
     EXPECT_EQ(budget.scheduler.mode, CullMode::TwoPhase);
     EXPECT_DOUBLE_EQ(budget.scheduler.approx.errorBudgetPercent, 0.1);
     EXPECT_FALSE(budget.scheduler.approx.budgetEarlySet);
+    EXPECT_FALSE(budget.scheduler.approx.budgetRecount);
     EXPECT_TRUE(modeFromName("budgetearly0.5")->scheduler.approx.budgetEarlySet);
+    EXPECT_TRUE(modeFromName("budgetrecount0.5")->scheduler.approx.budgetRecount);
     EXPECT_EQ(modeFromName("full")->scheduler.approx.errorBudgetPercent, 0.0);
     // A budget is a percentage in (0, 100], written as a plain decimal.
     for (const char* bad : {"budget0", "budget-1", "budget101", "budget1e-3", "budget", "budget0.1x", "budget0.1+thr16"})

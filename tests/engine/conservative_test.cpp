@@ -261,7 +261,7 @@ TEST_F(ConservativeSwarm, EveryQueryVolumeDrawsTheVfcImage) {
 TEST_F(ConservativeSwarm, ApproximateSettingsNeverLoseMoreThanTheyClaim) {
     ASSERT_NO_FATAL_FAILURE(build("dyncull_claims_", 24));
 
-    auto modes = cli::modesFromList("vfc,budget0.1,budget2,thr64,small2000,latency1");
+    auto modes = cli::modesFromList("vfc,budget0.1,budget2,thr64,small2000,budgetrecount2,latency1");
     ASSERT_TRUE(modes.ok()) << modes.error().message;
     for (cli::ModeSpec& m : *modes) m.scheduler.tuning.queryTimeoutMs = 20000.0;
     auto runner = cli::BenchRunner::create(*engine, *scene, modes.take());

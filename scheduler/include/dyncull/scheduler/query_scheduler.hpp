@@ -120,6 +120,13 @@ struct SchedulerApproximations {
     /// slower than without, since the parts it hands over are missing from the early depth
     /// (docs/BENCHMARKS.md).
     bool budgetEarlySet = false;
+    /// With an error budget: the candidates whose samples could fit in it are drawn last,
+    /// after being counted again against the depth of everything else drawn, and the
+    /// budget is spent on those counts. Off by default: the same parts were culled with and
+    /// without the recount on the bunny path and the city (the small parts peek past
+    /// silhouettes that the late draws do not cover; docs/BENCHMARKS.md), so it only adds a
+    /// batch and a wait.
+    bool budgetRecount = false;
 };
 
 /// TwoPhase's cost model: a volume the pyramid cannot reject is tested only where the
@@ -406,7 +413,13 @@ private:
     /// that fit in the frame's budget into Occluded, marking them in budgetCulled_, and
     /// charges their samples to the frame's claim.
     void spendErrorBudget(Frame& f);
-    std::vector<std::uint8_t> budgetCulled_;  // per candidate, this frame
+    /// Per candidate, this frame: decided by its answer, culled within the budget, or
+    /// waiting to be counted again (budgetRecount).
+    enum : std::uint8_t { kBudgetNo, kBudgetCulled, kBudgetLater };
+    std::vector<std::uint8_t> budgetCulled_;
+    std::vector<TestedPart> waitingParts_;
+    /// Culls, draws or hands on to triangle tests each candidate by its answer.
+    void settleCandidates(Frame& f, bool triangles);
     std::vector<std::pair<double, std::uint32_t>> budgetOrder_;  // (drawing saved per sample, candidate)
 
     // useClusters (cluster_culling.cpp): the ranges of the part being drawn, and per model
