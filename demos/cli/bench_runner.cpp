@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cstdio>
 #include <filesystem>
+#include <string_view>
 
 #include "dyncull/measure/png_writer.hpp"
 #include "dyncull/bsp/traversal.hpp"
@@ -21,13 +22,16 @@ bool parseU32(const std::string& s, std::uint32_t& out) {
     return ec == std::errc() && p == s.data() + s.size();
 }
 
-/// "budget0.1" -> 0.1 for prefix "budget": a finite decimal in (0, 100].
+/// Whole string as a plain decimal percentage in (0, 100], or false.
+bool parsePercent(std::string_view s, double& out) {
+    const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), out, std::chars_format::fixed);
+    return !s.empty() && ec == std::errc() && p == s.data() + s.size() && out > 0.0 && out <= 100.0;
+}
+
+/// "budget0.1" -> 0.1 for prefix "budget".
 bool percentAfter(const std::string& name, const std::string& prefix, double& out) {
-    if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) return false;
-    const char* first = name.data() + prefix.size();
-    const char* last = name.data() + name.size();
-    const auto [p, ec] = std::from_chars(first, last, out, std::chars_format::fixed);
-    return ec == std::errc() && p == last && out > 0.0 && out <= 100.0;
+    return name.size() > prefix.size() && name.compare(0, prefix.size(), prefix) == 0 &&
+           parsePercent(std::string_view(name).substr(prefix.size()), out);
 }
 
 /// "thr16" -> 16 for prefix "thr".
@@ -58,20 +62,16 @@ ModeSpec queriesMode(const std::string& name) {
 
 /// `full` and its ablations (two-phase), or false.
 bool applyTwoPhaseName(const std::string& part, ModeSpec& m) {
-    double budget = 0.0;
-    if (percentAfter(part, "budgetrecount", budget)) {
-        // The error budget with the parts that could fit counted again, last: measured, off.
+    // full with an error budget: culls visible parts while their samples fit in it; the
+    // variants hand it early-set parts that show less (budgetearly), or count the parts
+    // that could fit again, last (budgetrecount). No prefix's number parses after another's.
+    for (const std::string prefix : {"budget", "budgetearly", "budgetrecount"}) {
+        double budget = 0.0;
+        if (!percentAfter(part, prefix, budget)) continue;
         m.scheduler.mode = CullMode::TwoPhase;
         m.scheduler.approx.errorBudgetPercent = budget;
-        m.scheduler.approx.budgetRecount = true;
-        return true;
-    }
-    if (percentAfter(part, "budget", budget) || percentAfter(part, "budgetearly", budget)) {
-        // full with an error budget: culls visible parts while their samples fit in it.
-        // budgetearly: parts of the early set showing less than the budget handed to it.
-        m.scheduler.mode = CullMode::TwoPhase;
-        m.scheduler.approx.errorBudgetPercent = budget;
-        m.scheduler.approx.budgetEarlySet = part.compare(0, 11, "budgetearly") == 0;
+        m.scheduler.approx.budgetEarlySet = prefix == "budgetearly";
+        m.scheduler.approx.budgetRecount = prefix == "budgetrecount";
         return true;
     }
     if (part != "full" && part != "full-hzb" && part != "full-nohist" && part != "full-nocost" && part != "full-tri" &&
@@ -276,7 +276,7 @@ Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec) {
         double percent = 0.0;
         ModeSpec m = queriesMode(param + "=" + text);
         if (param == "error-budget") {
-            if (!percentAfter("=" + text, "=", percent))
+            if (!parsePercent(text, percent))
                 return Error{"--param error-budget: '" + text + "' is not a percentage in (0, 100]"};
             m.scheduler.mode = CullMode::TwoPhase;
             m.scheduler.approx.errorBudgetPercent = percent;
@@ -335,6 +335,7 @@ Expected<std::unique_ptr<BenchRunner>> BenchRunner::create(Engine& engine, DemoS
     res.width = engine.context().size().x;
     res.height = engine.context().size().y;
     r->images_.resize(res.modes.size());
+    r->missing_.resize(res.modes.size());
     return r;
 }
 
@@ -424,7 +425,6 @@ void BenchRunner::splitDifferingPixels(const std::vector<NodeRef>& drawn, ModeFr
 }
 
 void BenchRunner::countPopIn(std::size_t mode, const std::vector<NodeRef>& drawn, ModeFrame& out) {
-    if (missing_.size() < result_.modes.size()) missing_.resize(result_.modes.size());
     std::vector<NodeRef>& missing = missing_[mode];
     for (const NodeRef& p : missing)
         if (std::binary_search(drawn.begin(), drawn.end(), p)) ++out.popIn;

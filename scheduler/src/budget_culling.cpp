@@ -12,9 +12,13 @@
 
 namespace dyncull {
 
-void QueryScheduler::spendErrorBudget(Frame& f) {
+std::uint64_t QueryScheduler::errorBudgetPixels(const Frame& f) const {
     const double pixels = double(f.view.width) * double(f.view.height);
-    const std::uint64_t budget = static_cast<std::uint64_t>(std::floor(params_.approx.errorBudgetPercent / 100.0 * pixels));
+    return static_cast<std::uint64_t>(std::floor(params_.approx.errorBudgetPercent / 100.0 * pixels));
+}
+
+void QueryScheduler::spendErrorBudget(Frame& f) {
+    const std::uint64_t budget = errorBudgetPixels(f);
     std::uint64_t spent = f.stats.claimedErrorPixels;  // what other settings claimed already
     if (spent >= budget) return;
     budgetOrder_.clear();

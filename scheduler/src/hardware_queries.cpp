@@ -14,15 +14,8 @@
 namespace dyncull {
 
 void QueryScheduler::runQueries(Frame& f) {
-    const int tile = params_.tuning.occupancyTileSize;
-    if (drawnMap_.tilesX() * tile < f.view.width || drawnMap_.tilesY() * tile < f.view.height ||
-        (drawnMap_.tilesX() - 1) * tile >= f.view.width) {
-        drawnMap_.reset(f.view.width, f.view.height, tile);
-        waitingMap_.reset(f.view.width, f.view.height, tile);
-    } else {
-        drawnMap_.clear();
-        waitingMap_.clear();
-    }
+    drawnMap_.resetOrClear(f.view.width, f.view.height, params_.tuning.occupancyTileSize);
+    waitingMap_.resetOrClear(f.view.width, f.view.height, params_.tuning.occupancyTileSize);
     queries_->beginFrame(params_, f.view.width, f.view.height);
     waiting_.clear();
     answeredSinceRetry_ = false;
@@ -81,10 +74,8 @@ void QueryScheduler::queryOrWait(Frame& f, NodeRef ref, const Aabb& box, NodeHis
     // With useWaitOrder a waiting node also blocks every farther node whose rectangle
     // overlaps it (waitingMap_), so no node is queried before a nearer occluder in front of
     // it is drawn (fewer parts drawn for nothing, more waiting).
-    const bool keepOrder = params_.features.useWaitOrder && !params_.approx.batchOverlapping;
-    if (!(keepOrder && !waiting_.empty() && waitingMap_.anySet(rect)) && queries_->canIssue(rect)) {
-        notePlacement(f, ref);
-        queries_->issue(f, ref, queryVolume(f, ref, box), rect);
+    if (!(keepsWaitOrder() && !waiting_.empty() && waitingMap_.anySet(rect)) && queries_->canIssue(rect)) {
+        issueQuery(f, ref, box, rect);
         return;
     }
     const glm::vec3 d = glm::vec3(glm::dvec3(box.center()) - glm::dvec3(f.camera().position));
@@ -144,15 +135,14 @@ bool QueryScheduler::retryWaiting(Frame& f) {
     // farther ones it overlaps when the order is kept.
     if (!answeredSinceRetry_ || waiting_.empty()) return false;
     answeredSinceRetry_ = false;
-    const bool keepOrder = params_.features.useWaitOrder && !params_.approx.batchOverlapping;
+    const bool keepOrder = keepsWaitOrder();
     waitingMap_.clear();
     bool issued = false;
     std::size_t kept = 0;  // compacts in place, keeping the order
     for (const Waiting& w : waiting_) {
         const bool blocked = keepOrder && waitingMap_.anySet(w.rect);
         if (!blocked && queries_->canIssue(w.rect)) {
-            notePlacement(f, w.ref);
-            queries_->issue(f, w.ref, queryVolume(f, w.ref, w.box), w.rect);
+            issueQuery(f, w.ref, w.box, w.rect);
             issued = true;
         } else {
             waitingMap_.mark(w.rect);
@@ -173,13 +163,16 @@ void QueryScheduler::collectLatent(Frame& f) {
     });
 }
 
-void QueryScheduler::notePlacement(const Frame& f, NodeRef ref) {
-    if (ref.isSceneNode()) return;
-    const std::uint64_t placed = f.objects.placedAt(ref.object);
-    if (placed != lastPlacement_[ref.object]) {
-        lastPlacement_[ref.object] = placed;
-        stillSince_[ref.object] = f.index;
+void QueryScheduler::issueQuery(Frame& f, NodeRef ref, const Aabb& box, const ScreenRect& rect) {
+    if (!ref.isSceneNode()) {
+        // When the object last changed its transform, for tightenAfterFrames.
+        const std::uint64_t placed = f.objects.placedAt(ref.object);
+        if (placed != lastPlacement_[ref.object]) {
+            lastPlacement_[ref.object] = placed;
+            stillSince_[ref.object] = f.index;
+        }
     }
+    queries_->issue(f, ref, queryVolume(f, ref, box), rect);
 }
 
 }  // namespace dyncull

@@ -18,6 +18,14 @@ void OccupancyMap::reset(int width, int height, int tileSize) {
 
 void OccupancyMap::clear() { std::fill(bits_.begin(), bits_.end(), 0); }
 
+void OccupancyMap::resetOrClear(int width, int height, int tileSize) {
+    assert(tileSize > 0);
+    if (tileSize == tileSize_ && tilesX_ == (width + tileSize - 1) / tileSize && tilesY_ == (height + tileSize - 1) / tileSize)
+        clear();
+    else
+        reset(width, height, tileSize);
+}
+
 OccupancyMap::TileRange OccupancyMap::tiles(const ScreenRect& r) const {
     // A pixel rectangle [x0, x1) touches tiles x0/ts .. (x1-1)/ts.
     TileRange t{std::max(r.x0, 0) / tileSize_, std::max(r.y0, 0) / tileSize_, 0, 0};

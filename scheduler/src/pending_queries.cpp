@@ -12,11 +12,7 @@ void QueryIssuer::beginFrame(const SchedulerParams& params, int width, int heigh
     maxInFlight_ = params.tuning.maxQueriesInFlight;
     batching_ = params.features.useBatching;
     overlapping_ = params.approx.batchOverlapping;
-    const int tile = params.tuning.occupancyTileSize;
-    if (pendingMap_.tilesX() * tile < width || pendingMap_.tilesY() * tile < height || (pendingMap_.tilesX() - 1) * tile >= width)
-        pendingMap_.reset(width, height, tile);
-    else
-        pendingMap_.clear();
+    pendingMap_.resetOrClear(width, height, params.tuning.occupancyTileSize);
 }
 
 bool QueryIssuer::canIssue(const ScreenRect& rect) const {

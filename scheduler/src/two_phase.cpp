@@ -211,10 +211,10 @@ void QueryScheduler::testCandidates(Frame& f, bool triangles) {
     // The candidates small enough to fit in the budget wait until the others are drawn,
     // and are counted again against that nearer depth: they show fewer samples there
     // (often none), so the same budget takes more of them.
-    const double budgetPixels = params_.approx.errorBudgetPercent / 100.0 * double(f.view.width) * double(f.view.height);
+    const std::uint64_t budgetPixels = errorBudgetPixels(f);
     waitingParts_.clear();
     for (std::size_t i = 0; i < candidates_.size(); ++i)
-        if (rasterAnswers_[i] != QueryResult::Occluded && double(rasterSamples_[i]) <= budgetPixels) {
+        if (rasterAnswers_[i] != QueryResult::Occluded && rasterSamples_[i] <= budgetPixels) {
             budgetCulled_[i] = kBudgetLater;
             waitingParts_.push_back(candidates_[i]);
         }
@@ -262,12 +262,12 @@ void QueryScheduler::testRefresh(Frame& f) {
     // left out of next frame's early set, so that it is a candidate the budget may cull
     // then (drawn this frame, it costs no error now).
     const bool budget = params_.approx.errorBudgetPercent > 0.0 && params_.approx.budgetEarlySet;
-    const double budgetPixels = params_.approx.errorBudgetPercent / 100.0 * double(f.view.width) * double(f.view.height);
+    const std::uint64_t budgetPixels = errorBudgetPixels(f);
     rasterTest(f, refresh_, budget);
     learnOccludedRate(refreshOccludedRate_, rasterAnswers_);
     for (std::size_t i = 0; i < refresh_.size(); ++i) {
         const bool visible = rasterAnswers_[i] != QueryResult::Occluded &&
-                             !(budget && rasterSamples_[i] != kUnknownSamples && double(rasterSamples_[i]) <= budgetPixels);
+                             !(budget && rasterSamples_[i] != kUnknownSamples && rasterSamples_[i] <= budgetPixels);
         if (!visible) culledTriangles_ += subtreeTriangles(f, refresh_[i].ref);  // not drawn early next frame
         history_.recordAnswer(history_.at(refresh_[i].ref, objs), visible, f.index);
     }

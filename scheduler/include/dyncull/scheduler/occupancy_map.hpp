@@ -25,6 +25,9 @@ public:
     /// Covers a width x height pixel viewport with tiles of `tileSize` pixels.
     void reset(int width, int height, int tileSize);
     void clear();
+    /// The map reset() would make, emptied: its storage is kept when it already has that
+    /// shape (the per-frame call).
+    void resetOrClear(int width, int height, int tileSize);
 
     /// Sets every tile the rectangle touches.
     void mark(const ScreenRect& r);

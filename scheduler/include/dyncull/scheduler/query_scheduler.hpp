@@ -299,8 +299,7 @@ private:
     /// The volume Queries tests `ref` with: its world box, or once its object is still
     /// (tightenAfterFrames) its own volume.
     QueryVolume queryVolume(const Frame& f, NodeRef ref, const Aabb& worldBox) const;
-    /// Notes when `ref`'s object last changed its transform (for tightenAfterFrames).
-    void notePlacement(const Frame& f, NodeRef ref);
+
     std::uint32_t countFrustumLeaves(const Frame& f) const;
 
     // The modes.
@@ -324,6 +323,10 @@ private:
     void decideByLastAnswer(Frame& f, NodeRef ref, const Aabb& box, NodeHistory& h);
     /// Records a query's answer and draws or culls its node.
     void finishQuery(Frame& f, NodeRef ref, QueryResult r);
+    /// Issues the query of node `ref` (world box `box`, covering `rect`) now.
+    void issueQuery(Frame& f, NodeRef ref, const Aabb& box, const ScreenRect& rect);
+    /// useWaitOrder in effect: a waiting node holds back farther nodes it overlaps.
+    bool keepsWaitOrder() const { return params_.features.useWaitOrder && !params_.approx.batchOverlapping; }
     /// Issues queries for waiting nodes, nearest first, that can now be issued; true if any was.
     bool retryWaiting(Frame& f);
     /// Records the answers of the latency setting's queries that have arrived (non-blocking).
@@ -413,6 +416,8 @@ private:
     /// that fit in the frame's budget into Occluded, marking them in budgetCulled_, and
     /// charges their samples to the frame's claim.
     void spendErrorBudget(Frame& f);
+    /// The error budget in whole pixels of this frame's viewport.
+    std::uint64_t errorBudgetPixels(const Frame& f) const;
     /// Per candidate, this frame: decided by its answer, culled within the budget, or
     /// waiting to be counted again (budgetRecount).
     enum : std::uint8_t { kBudgetNo, kBudgetCulled, kBudgetLater };
