@@ -14,7 +14,7 @@
 
 #include "dyncull/loaders/loaders.hpp"
 #include "loader_common.hpp"
-#include "polygon_triangulation.hpp"
+#include "dyncull/objects/polygon_triangulation.hpp"
 
 namespace dyncull {
 namespace {
@@ -204,12 +204,12 @@ private:
             return fail("face has " + std::to_string(face_.size()) + " corner" + (face_.size() == 1 ? "" : "s") +
                         " (a face needs at least 3)");
         local_.clear();
-        switch (detail::triangulatePolygon(corners_, local_, scratch_)) {
-            case detail::Triangulation::TooComplex:
+        switch (triangulatePolygon(corners_, local_, scratch_)) {
+            case Triangulation::TooComplex:
                 return fail("face with " + std::to_string(face_.size()) + " corners is too complex to triangulate");
-            case detail::Triangulation::Ok:
-            case detail::Triangulation::ZeroArea:  // covers no surface: no triangles
-            case detail::Triangulation::Tangled:   // self-intersecting: best-effort triangles
+            case Triangulation::Ok:
+            case Triangulation::ZeroArea:  // covers no surface: no triangles
+            case Triangulation::Tangled:   // self-intersecting: best-effort triangles
                 break;
         }
         for (std::uint32_t k : local_) shape_.mesh.indices.push_back(face_[k]);
@@ -236,7 +236,7 @@ private:
     Shape shape_;
     std::vector<std::uint32_t> face_, local_;
     std::vector<glm::vec3> corners_;
-    detail::TriangulationScratch scratch_;
+    TriangulationScratch scratch_;
 };
 
 Expected<Scene> loadObjImpl(const std::filesystem::path& path) {

@@ -7,9 +7,9 @@
 #include <gtest/gtest.h>
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "polygon_triangulation.hpp"
+#include "dyncull/objects/polygon_triangulation.hpp"
 
-namespace dyncull::detail {
+namespace dyncull {
 namespace {
 
 // Polygon in the xy plane, then carried into 3D by `toWorld` (so the projection step is tested too).
@@ -184,4 +184,4 @@ TEST(PolygonTriangulation, HugeSpikyPolygonHitsTheWorkBudget) {
 }
 
 }  // namespace
-}  // namespace dyncull::detail
+}  // namespace dyncull

@@ -1,5 +1,5 @@
 // Ear-clipping triangulation of one polygon face (OBJ and PLY faces with more than three
-// corners). Private to the loaders.
+// corners, and polygons streamed from files larger than memory).
 #pragma once
 
 #include <cstdint>
@@ -8,7 +8,7 @@
 
 #include <glm/glm.hpp>
 
-namespace dyncull::detail {
+namespace dyncull {
 
 enum class Triangulation : std::uint8_t {
     Ok,          ///< ear-clipped (for a convex polygon: the fan from corner 0)
@@ -32,4 +32,4 @@ struct TriangulationScratch {
 Triangulation triangulatePolygon(std::span<const glm::vec3> corners, std::vector<std::uint32_t>& out,
                                  TriangulationScratch& scratch);
 
-}  // namespace dyncull::detail
+}  // namespace dyncull

@@ -1,14 +1,14 @@
 // Ear clipping on the polygon's dominant plane. The plane is chosen from Newell's normal,
 // which is robust for slightly non-planar faces; only reflex (and flat) corners can lie
 // inside an ear of a simple polygon, so the inside test scans just those.
-#include "polygon_triangulation.hpp"
+#include "dyncull/objects/polygon_triangulation.hpp"
 
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
 #include <cstddef>
 
-namespace dyncull::detail {
+namespace dyncull {
 namespace {
 
 // Twice the signed area of triangle abc (> 0 when counter-clockwise).
@@ -146,4 +146,4 @@ Triangulation triangulatePolygon(std::span<const glm::vec3> corners, std::vector
     return result;
 }
 
-}  // namespace dyncull::detail
+}  // namespace dyncull
