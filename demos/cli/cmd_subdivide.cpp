@@ -3,6 +3,8 @@
 // merged into one soup) into subdivision entities and saves it for `dyncull run/bench
 // FILE`. Prints the tree's size, the build time and the memory used while subdividing.
 // Paper: Scene subdivision for occlusion culling, section 3.
+// With --memory-mb N it builds a streamed model (FILE.dnodes + FILE.dgeom) out of core
+// instead, never holding the whole model: a PLY source is streamed from disk.
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -13,6 +15,9 @@
 #include "commands.hpp"
 #include "dyncull/bsp/subdivision_file.hpp"
 #include "dyncull/demos/demo_scene.hpp"
+#include "dyncull/demos/progress_bar.hpp"
+#include "dyncull/loaders/ply_stream.hpp"
+#include "dyncull/streaming/out_of_core_subdivision.hpp"
 #include "scene_options.hpp"
 
 namespace dyncull::cli {
@@ -21,6 +26,8 @@ namespace {
 struct SubdivideCommandOptions {
     std::string source;
     std::string out;
+    std::uint32_t memoryMb = 0;  // > 0: out of core under this budget
+    std::string tempDir;
     SceneOptions sceneOptions;
 };
 
@@ -42,7 +49,77 @@ bool resetPeakRss() {
 
 double mb(std::size_t bytes) { return static_cast<double>(bytes) / (1024.0 * 1024.0); }
 
+bool hasExtension(const std::string& path, const char* ext) {
+    std::string e = std::filesystem::path(path).extension().string();
+    for (char& c : e) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return e == ext;
+}
+
+/// Out of core: a PLY file is streamed from disk; other sources (built-in scenes, OBJ,
+/// glTF, directories) are loaded whole first, then streamed from memory.
+void runSubdivideOutOfCore(const SubdivideCommandOptions& o) {
+    auto sp = toSubdivisionParams(o.sceneOptions.subdivide);
+    if (!sp) fail(sp.error().message);
+    if (!hasExtension(o.out, ".dnodes")) fail("--out " + o.out + ": a streamed model is named BASE.dnodes (with BASE.dgeom beside it)");
+    OutOfCoreParams params;
+    params.subdivision = *sp;
+    params.memoryBytes = std::size_t{o.memoryMb} << 20;
+    params.tempDirectory = o.tempDir;
+    Stopwatch sw;
+    std::optional<StaticSoup> soup;
+    MeshStreamSource source;
+    if (hasExtension(o.source, ".ply")) {
+        params.source = o.source;
+        source = [&](MeshStreamSink& sink) { return streamPly(o.source, sink); };
+    } else {
+        auto loaded = loadStaticSoup(o.source, o.sceneOptions);
+        if (!loaded) fail(loaded.error().message);
+        soup = loaded.take();
+        params.source = soup->source;
+        params.sourceHash = soup->sourceHash;
+        source = meshSource(soup->mesh);
+        std::printf("%s: not a PLY file, loaded whole (%zu triangles) in %.1f s, then streamed from memory\n",
+                    o.source.c_str(), soup->mesh.triangleCount(), sw.lap() / 1000.0);
+    }
+    if (Status st = ensureParentDirectory(o.out); !st) fail(st.message());
+    std::optional<ProgressBar> bar;
+    std::string phase;
+    double shown = 0.0;
+    const OutOfCoreProgress progress = [&](const char* name, double done, double total) {
+        if (phase != name) {
+            phase = name;
+            shown = 0.0;
+            if (!bar) bar.emplace(name, total);
+            else bar->restart(name, total);
+        }
+        bar->advance(done - shown);
+        shown = done;
+    };
+    auto stats = subdivideOutOfCore(source, o.out, params, progress);
+    if (bar) bar->finish();
+    if (!stats) fail(o.source + ": " + stats.error().message);
+    const OutOfCoreStats& s = *stats;
+    const double seconds = sw.lap() / 1000.0;
+    std::printf("%s: %llu vertices, %llu polygons, %llu triangles; normals %s\n", o.source.c_str(),
+                static_cast<unsigned long long>(s.vertices), static_cast<unsigned long long>(s.polygons),
+                static_cast<unsigned long long>(s.triangles), s.normalsFromSource ? "from the file" : "computed");
+    std::printf("tree: %u nodes, %u leaves; %u streamed splits, %u subtrees built in memory (largest %llu triangles, "
+                "limit %llu)\n",
+                s.nodes, s.leaves, s.streamedSplits, s.memorySubtrees, static_cast<unsigned long long>(s.largestSubtree),
+                static_cast<unsigned long long>(s.subtreeLimit));
+    std::printf("time: %.1f s (reading %.1f, triangulating %.1f, subdividing %.1f)\n", seconds, s.readMs / 1000.0,
+                s.triangulateMs / 1000.0, s.buildMs / 1000.0);
+    std::printf("memory: budget %u MB, peak resident %.1f MB; vertex cache %.2f%% misses of %llu lookups; "
+                "temporary files %.1f MB written, %.1f MB read\n",
+                o.memoryMb, mb(procStatusBytes("VmHWM:")),
+                s.cacheLookups ? 100.0 * static_cast<double>(s.cacheMisses) / static_cast<double>(s.cacheLookups) : 0.0,
+                static_cast<unsigned long long>(s.cacheLookups), mb(s.tempBytesWritten), mb(s.tempBytesRead));
+    std::printf("wrote %s and %s (%.1f MB of geometry)\n", o.out.c_str(), geometryPathFor(o.out).c_str(),
+                mb(s.geometryBytes));
+}
+
 void runSubdivide(const SubdivideCommandOptions& o) {
+    if (o.memoryMb > 0) return runSubdivideOutOfCore(o);
     auto params = toSubdivisionParams(o.sceneOptions.subdivide);
     if (!params) fail(params.error().message);
     Stopwatch sw;
@@ -101,7 +178,12 @@ void registerSubdivide(CLI::App& app) {
         "subdivide", "Cut a static model into objects (p-HBVO, D-BVS, octrees) and save it for run/bench");
     cmd->add_option("source", o->source, "a model file, a directory of .ply/.obj parts, or powerplant / city (merged into one soup)")
         ->required();
-    cmd->add_option("--out", o->out, "output file (.dsub), read by `dyncull run/bench FILE`")->required();
+    cmd->add_option("--out", o->out, "output file (.dsub), read by `dyncull run/bench FILE`; with --memory-mb, BASE.dnodes")
+        ->required();
+    cmd->add_option("--memory-mb", o->memoryMb,
+                    "build out of core under this many MB (PLY sources stream from disk); writes BASE.dnodes + BASE.dgeom")
+        ->check(wholeIn(16, 1 << 20));
+    cmd->add_option("--temp-dir", o->tempDir, "with --memory-mb: where temporary files go (default: beside --out)");
     SubdivideOptions& s = o->sceneOptions.subdivide;
     cmd->add_option("--method", s.method, "phbvo, dbvs, octree (load-balanced) or grid (regular octree)")->capture_default_str();
     cmd->add_option("--max-tris", s.maxTriangles, "maximum triangles per leaf (object)")

@@ -1,0 +1,349 @@
+// Out-of-core subdivision and the streamed model files: every source triangle in exactly one
+// leaf, limits held, the same leaves as in memory when nothing needs streaming, and every
+// truncation or corruption of either file an error naming the file (and the leaf).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "dyncull/loaders/loaders.hpp"
+#include "dyncull/loaders/ply_stream.hpp"
+#include "dyncull/objects/checksum.hpp"
+#include "dyncull/streaming/out_of_core_subdivision.hpp"
+#include "dyncull/streaming/streamed_model.hpp"
+#include "objects/test_files.hpp"
+
+namespace dyncull {
+namespace {
+
+using test::TempDir;
+
+/// `n` x `n` x 2 closed UV spheres of `rings` x `segments` quads (as triangles), with
+/// shared vertices: a scanned-like surface in many clumps.
+Mesh sphereField(int n, int rings, int segments) {
+    Mesh m;
+    m.name = "spheres";
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j)
+            for (int k = 0; k < 2; ++k) {
+                const glm::vec3 c(3.0f * i, 3.0f * k, 3.0f * j);
+                const auto base = static_cast<std::uint32_t>(m.positions.size());
+                for (int r = 0; r <= rings; ++r)
+                    for (int s = 0; s < segments; ++s) {
+                        const float th = 3.14159265f * r / rings, ph = 6.2831853f * s / segments;
+                        m.positions.push_back(c + glm::vec3(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph)));
+                    }
+                for (int r = 0; r < rings; ++r)
+                    for (int s = 0; s < segments; ++s) {
+                        const std::uint32_t a = base + r * segments + s, b = base + r * segments + (s + 1) % segments;
+                        const std::uint32_t c2 = a + segments, d = b + segments;
+                        m.indices.insert(m.indices.end(), {a, c2, b, b, c2, d});
+                    }
+            }
+    return m;
+}
+
+using Tri = std::array<float, 9>;
+
+/// A triangle as its corner positions, rotated so the smallest corner comes first (leaf
+/// ordering may rotate a triangle, never mirror it).
+Tri canonical(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
+    std::array<glm::vec3, 3> v{a, b, c};
+    auto less = [](const glm::vec3& x, const glm::vec3& y) {
+        return std::tie(x.x, x.y, x.z) < std::tie(y.x, y.y, y.z);
+    };
+    int first = 0;
+    for (int k = 1; k < 3; ++k)
+        if (less(v[k], v[first])) first = k;
+    Tri t;
+    for (int k = 0; k < 3; ++k)
+        for (int d = 0; d < 3; ++d) t[3 * k + d] = v[(first + k) % 3][d];
+    return t;
+}
+
+std::vector<Tri> trianglesOf(const Mesh& m) {
+    std::vector<Tri> out;
+    for (std::size_t t = 0; t < m.triangleCount(); ++t)
+        out.push_back(canonical(m.positions[m.indices[3 * t]], m.positions[m.indices[3 * t + 1]], m.positions[m.indices[3 * t + 2]]));
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+/// Reads every leaf back; checks each against its node and returns all triangles, sorted.
+std::vector<Tri> readAll(const StreamedModel& model, std::uint32_t maxLeaf) {
+    auto file = GeometryFile::open(model);
+    EXPECT_TRUE(file.ok()) << file.error().message;
+    std::vector<Tri> out;
+    LeafGeometry g;
+    std::vector<unsigned char> scratch;
+    for (std::uint32_t i = 0; i < model.leaves.size(); ++i) {
+        const Status s = file->read(i, g, scratch);
+        EXPECT_TRUE(s.ok()) << s.message();
+        const StreamedLeaf& leaf = model.leaves[i];
+        EXPECT_LE(leaf.triangleCount, maxLeaf);
+        EXPECT_EQ(g.indices.size(), 3u * leaf.triangleCount);
+        for (const glm::vec3& n : g.normals) EXPECT_NEAR(glm::length(n), 1.0f, 1e-4f);
+        for (const glm::vec3& p : g.positions)
+            EXPECT_TRUE(leaf.obb.contains(p, 1e-4f * (1.0f + glm::length(p))));
+        for (std::size_t t = 0; t < g.indices.size(); t += 3)
+            out.push_back(canonical(g.positions[g.indices[t]], g.positions[g.indices[t + 1]], g.positions[g.indices[t + 2]]));
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+OutOfCoreParams smallBudget(std::uint32_t maxLeaf = 1000) {
+    OutOfCoreParams p;
+    p.subdivision.maxLeafTriangles = maxLeaf;
+    p.memoryBytes = std::size_t{16} << 20;  // the minimum: 100k triangles need streamed splits
+    p.source = "test";
+    return p;
+}
+
+TEST(OutOfCoreSubdivision, EveryTriangleInExactlyOneLeafUnderASmallBudget) {
+    TempDir dir;
+    const Mesh mesh = sphereField(5, 30, 40);  // 50 spheres, 120,000 triangles
+    ASSERT_GT(mesh.triangleCount(), 100000u);
+    const auto path = dir.file("field.dnodes");
+    auto stats = subdivideOutOfCore(meshSource(mesh), path, smallBudget());
+    ASSERT_TRUE(stats.ok()) << stats.error().message;
+    EXPECT_GT(stats->streamedSplits, 0u) << "the budget should force streamed splits";
+    EXPECT_GT(stats->memorySubtrees, 1u);
+    EXPECT_LE(stats->largestSubtree, stats->subtreeLimit);
+    EXPECT_EQ(stats->triangles, mesh.triangleCount());
+    EXPECT_FALSE(stats->normalsFromSource);
+
+    auto model = readStreamedModel(path);
+    ASSERT_TRUE(model.ok()) << model.error().message;
+    EXPECT_EQ(model->triangles(), mesh.triangleCount());
+    EXPECT_EQ(model->leaves.size(), stats->leaves);
+    EXPECT_EQ(readAll(*model, 1000), trianglesOf(mesh));
+    // No temporary files are left beside the output.
+    const auto files = std::distance(std::filesystem::directory_iterator(dir.file("")), std::filesystem::directory_iterator());
+    EXPECT_EQ(files, 2);
+}
+
+TEST(OutOfCoreSubdivision, NormalsAreTheMeshsOwnWhetherGivenOrComputed) {
+    TempDir dir;
+    Mesh mesh = sphereField(2, 12, 16);
+    Mesh withNormals = mesh;
+    computeNormals(withNormals);
+    for (const bool given : {false, true}) {
+        const auto path = dir.file(given ? "given.dnodes" : "computed.dnodes");
+        auto stats = subdivideOutOfCore(meshSource(given ? withNormals : mesh), path, smallBudget(200));
+        ASSERT_TRUE(stats.ok()) << stats.error().message;
+        EXPECT_EQ(stats->normalsFromSource, given);
+        auto model = readStreamedModel(path);
+        ASSERT_TRUE(model.ok()) << model.error().message;
+        auto file = GeometryFile::open(*model);
+        ASSERT_TRUE(file.ok());
+        // Each leaf vertex's normal is the whole mesh's normal of the vertex at that position.
+        std::map<std::array<float, 3>, glm::vec3> expected;
+        for (std::size_t v = 0; v < withNormals.positions.size(); ++v)
+            expected[{withNormals.positions[v].x, withNormals.positions[v].y, withNormals.positions[v].z}] = withNormals.normals[v];
+        LeafGeometry g;
+        std::vector<unsigned char> scratch;
+        for (std::uint32_t i = 0; i < model->leaves.size(); ++i) {
+            ASSERT_TRUE(file->read(i, g, scratch).ok());
+            for (std::size_t v = 0; v < g.positions.size(); ++v) {
+                const auto it = expected.find({g.positions[v].x, g.positions[v].y, g.positions[v].z});
+                ASSERT_NE(it, expected.end());
+                // Sphere poles repeat a position with different ids; only the rest are unique.
+                if (std::fabs(std::fabs(g.positions[v].y - std::round(g.positions[v].y / 3.0f) * 3.0f) - 1.0f) < 1e-5f) continue;
+                EXPECT_NEAR(glm::distance(g.normals[v], it->second), 0.0f, 1e-5f);
+            }
+        }
+    }
+}
+
+TEST(OutOfCoreSubdivision, WithoutStreamedSplitsTheLeavesAreTheInMemoryOnes) {
+    TempDir dir;
+    const Mesh mesh = sphereField(3, 20, 30);
+    OutOfCoreParams p = smallBudget(800);
+    p.memoryBytes = std::size_t{256} << 20;
+    auto stats = subdivideOutOfCore(meshSource(mesh), dir.file("big.dnodes"), p);
+    ASSERT_TRUE(stats.ok()) << stats.error().message;
+    EXPECT_EQ(stats->streamedSplits, 0u);
+    EXPECT_EQ(stats->memorySubtrees, 1u);
+    auto model = readStreamedModel(dir.file("big.dnodes"));
+    ASSERT_TRUE(model.ok());
+    auto sub = subdivide(mesh, p.subdivision);
+    ASSERT_TRUE(sub.ok());
+    ASSERT_EQ(model->nodes.size(), sub->nodes.size());
+    for (std::size_t i = 0; i < sub->nodes.size(); ++i) {
+        EXPECT_EQ(model->nodes[i].triangleCount, sub->nodes[i].triangleCount);
+        EXPECT_EQ(model->nodes[i].box.min, sub->nodes[i].box.min);
+        EXPECT_EQ(model->nodes[i].box.max, sub->nodes[i].box.max);
+    }
+}
+
+TEST(OutOfCoreSubdivision, StreamsAPlyFileWithPolygonsAndFacesFirst) {
+    TempDir dir;
+    // A 40 x 40 grid of quads (some as pentagons with a midpoint) with the face element first.
+    const int n = 40;
+    std::string verts, faces;
+    int faceCount = 0;
+    for (int j = 0; j <= n; ++j)
+        for (int i = 0; i <= n; ++i) verts += std::to_string(i) + " " + std::to_string((i * j) % 7 * 0.1) + " " + std::to_string(j) + "\n";
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i, ++faceCount) {
+            const int a = j * (n + 1) + i;
+            faces += "4 " + std::to_string(a) + " " + std::to_string(a + n + 1) + " " + std::to_string(a + n + 2) + " " +
+                     std::to_string(a + 1) + "\n";
+        }
+    const std::string ply = "ply\nformat ascii 1.0\nelement face " + std::to_string(faceCount) +
+                            "\nproperty list uchar int vertex_indices\nelement vertex " + std::to_string((n + 1) * (n + 1)) +
+                            "\nproperty float x\nproperty float y\nproperty float z\nend_header\n" + faces + verts;
+    const auto src = dir.write("grid.ply", ply);
+    auto scene = loadPly(src);
+    ASSERT_TRUE(scene.ok()) << scene.error().message;
+    auto stats = subdivideOutOfCore([&](MeshStreamSink& s) { return streamPly(src, s); }, dir.file("grid.dnodes"), smallBudget(100));
+    ASSERT_TRUE(stats.ok()) << stats.error().message;
+    EXPECT_EQ(stats->polygons, std::uint64_t(faceCount));
+    auto model = readStreamedModel(dir.file("grid.dnodes"));
+    ASSERT_TRUE(model.ok()) << model.error().message;
+    EXPECT_EQ(readAll(*model, 100), trianglesOf(scene->meshes[0]));
+}
+
+TEST(OutOfCoreSubdivision, BadInputIsAnErrorAndLeavesNoFiles) {
+    TempDir dir;
+    const Mesh mesh = sphereField(1, 4, 4);
+    OutOfCoreParams p = smallBudget();
+    p.memoryBytes = std::size_t{8} << 20;
+    auto r = subdivideOutOfCore(meshSource(mesh), dir.file("a.dnodes"), p);
+    ASSERT_FALSE(r.ok());
+    EXPECT_NE(r.error().message.find("16 MiB"), std::string::npos) << r.error().message;
+    p = smallBudget(0);
+    EXPECT_FALSE(subdivideOutOfCore(meshSource(mesh), dir.file("a.dnodes"), p).ok());
+    // A source that fails half-way: its error comes back, and nothing is left behind.
+    const auto broken = [&](MeshStreamSink& s) -> Status {
+        MeshStreamLayout l;
+        l.vertices = 3;
+        l.faces = 1;
+        if (Status st = s.begin(l); !st) return st;
+        if (Status st = s.vertex(glm::vec3(0.0f), glm::vec3(0.0f)); !st) return st;
+        return Error{"broken source: vertex 1 is bad", ErrorCode::BadFile};
+    };
+    r = subdivideOutOfCore(broken, dir.file("b.dnodes"), smallBudget());
+    ASSERT_FALSE(r.ok());
+    EXPECT_NE(r.error().message.find("broken source"), std::string::npos);
+    const auto empty = [&](MeshStreamSink& s) -> Status { return s.begin(MeshStreamLayout{}); };
+    EXPECT_FALSE(subdivideOutOfCore(empty, dir.file("c.dnodes"), smallBudget()).ok());
+    EXPECT_TRUE(std::filesystem::is_empty(dir.file("")));
+}
+
+class StreamedModelFiles : public ::testing::Test {
+protected:
+    void SetUp() override {
+        mesh_ = sphereField(3, 16, 24);
+        nodes_ = dir_.file("m.dnodes");
+        auto stats = subdivideOutOfCore(meshSource(mesh_), nodes_, smallBudget(300));
+        ASSERT_TRUE(stats.ok()) << stats.error().message;
+        geometry_ = geometryPathFor(nodes_);
+        nodeBytes_ = readBytes(nodes_);
+        geometryBytes_ = readBytes(geometry_);
+    }
+    static std::string readBytes(const std::filesystem::path& p) {
+        std::ifstream f(p, std::ios::binary);
+        return {std::istreambuf_iterator<char>(f), {}};
+    }
+    static void writeBytes(const std::filesystem::path& p, const std::string& b) { std::ofstream(p, std::ios::binary) << b; }
+    void restore() {
+        writeBytes(nodes_, nodeBytes_);
+        writeBytes(geometry_, geometryBytes_);
+    }
+    TempDir dir_;
+    Mesh mesh_;
+    std::filesystem::path nodes_, geometry_;
+    std::string nodeBytes_, geometryBytes_;
+};
+
+TEST_F(StreamedModelFiles, EveryTruncationOfTheNodeFileIsAnError) {
+    for (std::size_t len = 0; len < nodeBytes_.size(); len += 1 + len / 7) {
+        writeBytes(nodes_, nodeBytes_.substr(0, len));
+        auto r = readStreamedModel(nodes_);
+        ASSERT_FALSE(r.ok()) << len;
+        EXPECT_EQ(r.error().message.rfind("node file " + nodes_.string(), 0), 0u) << r.error().message;
+    }
+}
+
+TEST_F(StreamedModelFiles, EveryFlippedByteOfTheNodeFileIsAnError) {
+    for (std::size_t at = 0; at < nodeBytes_.size(); at += 1 + at / 13) {
+        std::string b = nodeBytes_;
+        b[at] = static_cast<char>(b[at] ^ 0x5a);
+        writeBytes(nodes_, b);
+        EXPECT_FALSE(readStreamedModel(nodes_).ok()) << "byte " << at;
+    }
+}
+
+TEST_F(StreamedModelFiles, AForgedLeafTableIsCaughtByTheTreeCheck) {
+    // Valid checksum, bad content: rewrite a leaf's offset to overlap its neighbour, then
+    // re-seal the payload's checksum as a hostile writer would.
+    auto model = readStreamedModel(nodes_);
+    ASSERT_TRUE(model.ok());
+    ASSERT_GE(model->leaves.size(), 2u);
+    std::string b = nodeBytes_;
+    const std::size_t payload = b.size() - kStreamedHeaderSize;
+    // The leaf table is the payload's tail: 4-byte count, then 120 bytes per leaf; the
+    // offset is at byte 16 of a leaf.
+    const std::size_t leaf1 = b.size() - 120 * (model->leaves.size() - 1);
+    std::uint64_t off = model->leaves[0].offset;
+    std::memcpy(&b[leaf1 + 16], &off, 8);
+    const std::uint64_t sum = fnv1a64(b.data() + kStreamedHeaderSize, payload);
+    std::memcpy(&b[32], &sum, 8);
+    writeBytes(nodes_, b);
+    auto r = readStreamedModel(nodes_);
+    ASSERT_FALSE(r.ok());
+    EXPECT_NE(r.error().message.find("leaf"), std::string::npos) << r.error().message;
+}
+
+TEST_F(StreamedModelFiles, ATruncatedOrForeignGeometryFileIsRefusedAtOpen) {
+    writeBytes(geometry_, geometryBytes_.substr(0, geometryBytes_.size() - 1));
+    auto r = readStreamedModel(nodes_);
+    ASSERT_FALSE(r.ok());
+    EXPECT_NE(r.error().message.find("truncated"), std::string::npos) << r.error().message;
+    EXPECT_NE(r.error().message.find(geometry_.string()), std::string::npos);
+    std::filesystem::remove(geometry_);
+    EXPECT_FALSE(readStreamedModel(nodes_).ok());
+    // Another model's geometry file of the same name.
+    TempDir other;
+    const Mesh m2 = sphereField(2, 16, 24);
+    ASSERT_TRUE(subdivideOutOfCore(meshSource(m2), other.file("m.dnodes"), smallBudget(300)).ok());
+    std::filesystem::copy_file(geometryPathFor(other.file("m.dnodes")), geometry_);
+    r = readStreamedModel(nodes_);
+    ASSERT_FALSE(r.ok());
+    EXPECT_NE(r.error().message.find("does not belong"), std::string::npos) << r.error().message;
+}
+
+TEST_F(StreamedModelFiles, ACorruptChunkIsAnErrorNamingTheLeafAndOnlyThatLeaf) {
+    auto model = readStreamedModel(nodes_);
+    ASSERT_TRUE(model.ok());
+    const std::uint32_t bad = static_cast<std::uint32_t>(model->leaves.size() / 2);
+    std::string b = geometryBytes_;
+    b[model->leaves[bad].offset + model->leaves[bad].chunkBytes / 2] ^= 0x01;
+    writeBytes(geometry_, b);
+    auto file = GeometryFile::open(*model);
+    ASSERT_TRUE(file.ok());
+    LeafGeometry g;
+    std::vector<unsigned char> scratch;
+    for (std::uint32_t i = 0; i < model->leaves.size(); ++i) {
+        const Status s = file->read(i, g, scratch);
+        if (i != bad) {
+            EXPECT_TRUE(s.ok()) << s.message();
+            continue;
+        }
+        ASSERT_FALSE(s.ok());
+        EXPECT_NE(s.message().find("leaf " + std::to_string(bad) + " "), std::string::npos) << s.message();
+        EXPECT_NE(s.message().find(geometry_.string()), std::string::npos) << s.message();
+        EXPECT_EQ(s.error().code, ErrorCode::BadFile);
+    }
+    EXPECT_FALSE(file->read(static_cast<std::uint32_t>(model->leaves.size()), g, scratch).ok());
+}
+
+}  // namespace
+}  // namespace dyncull
