@@ -13,5 +13,6 @@ void registerInspect(CLI::App& app);
 void registerBench(CLI::App& app);
 void registerSweep(CLI::App& app);
 void registerSubdivide(CLI::App& app);
+void registerExport(CLI::App& app);
 
 }  // namespace dyncull::cli

@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
     dyncull::cli::registerBench(app);
     dyncull::cli::registerSweep(app);
     dyncull::cli::registerSubdivide(app);
+    dyncull::cli::registerExport(app);
     // CLI11 reports a mistyped command as "A subcommand is required": name it instead.
     if (argc > 1 && argv[1][0] != '-') {
         std::string known;

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "dyncull/loaders/loaders.hpp"
+#include "dyncull/loaders/ply_stream.hpp"
 #include "objects/test_files.hpp"
 
 namespace dyncull {
@@ -460,6 +461,55 @@ TEST(PlyLoader, ZeroAreaPolygonsAreDropped) {
     auto r = loadPly(path);
     ASSERT_TRUE(r.ok()) << r.error().message;
     EXPECT_EQ(r->meshes[0].triangleCount(), 1u);
+}
+
+}  // namespace
+}  // namespace dyncull
+
+namespace dyncull {
+namespace {
+
+TEST(PlyWriter, WritesWhatTheLoaderReadsBack) {
+    test::TempDir dir;
+    const std::vector<glm::vec3> p = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1.5f}};
+    for (const bool normals : {false, true}) {
+        const auto path = dir.file(normals ? "n.ply" : "p.ply");
+        PlyWriter w;
+        ASSERT_TRUE(w.open(path, 4, 2, normals, "test").ok());
+        for (const glm::vec3& v : p) ASSERT_TRUE(w.vertex(v, glm::vec3(0, 0, 2)).ok());
+        ASSERT_TRUE(w.triangle(0, 1, 2).ok());
+        ASSERT_TRUE(w.triangle(0, 2, 3).ok());
+        ASSERT_TRUE(w.close().ok());
+        auto scene = loadPly(path);
+        ASSERT_TRUE(scene.ok()) << scene.error().message;
+        const Mesh& m = scene->meshes[0];
+        EXPECT_EQ(m.positions, p);
+        EXPECT_EQ(m.indices, (std::vector<std::uint32_t>{0, 1, 2, 0, 2, 3}));
+        if (normals) EXPECT_EQ(m.normals[3], glm::vec3(0, 0, 1));  // the file's, normalised
+    }
+}
+
+TEST(PlyWriter, CountsOtherThanDeclaredAreAnErrorAndLeaveNoFile) {
+    test::TempDir dir;
+    const auto path = dir.file("bad.ply");
+    {
+        PlyWriter w;
+        ASSERT_TRUE(w.open(path, 3, 1, false).ok());
+        ASSERT_TRUE(w.vertex({0, 0, 0}).ok());
+        EXPECT_FALSE(w.triangle(0, 0, 0).ok());  // before every vertex
+        ASSERT_TRUE(w.vertex({1, 0, 0}).ok());
+        ASSERT_TRUE(w.vertex({0, 1, 0}).ok());
+        EXPECT_FALSE(w.vertex({0, 1, 0}).ok());  // one too many
+        EXPECT_FALSE(w.triangle(0, 1, 3).ok());  // out of range
+        const Status s = w.close();              // no triangle written
+        ASSERT_FALSE(s.ok());
+        EXPECT_NE(s.message().find("declares"), std::string::npos) << s.message();
+    }
+    EXPECT_TRUE(std::filesystem::is_empty(dir.file("")));
+    PlyWriter w;
+    const Status s = w.open(dir.file("no/such/dir/x.ply"), 3, 1, false);
+    ASSERT_FALSE(s.ok());
+    EXPECT_NE(s.message().find("x.ply"), std::string::npos);
 }
 
 }  // namespace
