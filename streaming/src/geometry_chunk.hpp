@@ -14,7 +14,7 @@ inline constexpr char kGeometryMagic[8] = {'D', 'Y', 'N', 'C', 'G', 'E', 'O', '\
 inline constexpr std::size_t kChunkHeaderBytes = 16;
 
 /// Appends `g`'s chunk to `out` (cleared first). "" or why it cannot be encoded.
-std::string encodeChunk(const LeafGeometry& g, std::vector<unsigned char>& out);
+std::string encodeChunk(const Mesh& g, std::vector<unsigned char>& out);
 
 /// The 48-byte geometry file header.
 void encodeGeometryHeader(std::uint64_t geometryId, std::uint64_t fileBytes, unsigned char out[kStreamedHeaderSize]);

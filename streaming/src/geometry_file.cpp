@@ -14,7 +14,7 @@
 namespace dyncull {
 namespace detail {
 
-std::string encodeChunk(const LeafGeometry& g, std::vector<unsigned char>& out) {
+std::string encodeChunk(const Mesh& g, std::vector<unsigned char>& out) {
     const std::size_t v = g.positions.size(), idx = g.indices.size();
     if (v == 0 || idx == 0 || idx % 3 != 0) return "a leaf needs vertices and whole triangles";
     if (g.normals.size() != v) return "a leaf needs one normal per vertex";
@@ -84,6 +84,10 @@ bool readAllAt(int fd, void* bytes, std::size_t size, std::uint64_t offset) {
 
 }  // namespace detail
 
+std::size_t leafBytes(const Mesh& leaf) {
+    return (leaf.positions.size() + leaf.normals.size()) * sizeof(glm::vec3) + leaf.indices.size() * sizeof(std::uint32_t);
+}
+
 struct GeometryFile::State {
     std::filesystem::path path;
     std::vector<StreamedLeaf> leaves;
@@ -109,7 +113,7 @@ Expected<GeometryFile> GeometryFile::open(const StreamedModel& model) {
     return GeometryFile(std::move(s));
 }
 
-Status GeometryFile::read(std::uint32_t leafIndex, LeafGeometry& out, std::vector<unsigned char>& scratch) const {
+Status GeometryFile::read(std::uint32_t leafIndex, Mesh& out, std::vector<unsigned char>& scratch) const {
     const State& s = *s_;
     if (leafIndex >= s.leaves.size())
         return Error{"geometry file " + s.path.string() + ": no leaf " + std::to_string(leafIndex), ErrorCode::BadArgument};

@@ -158,7 +158,7 @@ Expected<StreamedModelWriter> StreamedModelWriter::create(const std::filesystem:
     return StreamedModelWriter(std::move(s));
 }
 
-Expected<std::uint32_t> StreamedModelWriter::addLeaf(const LeafGeometry& g, std::uint32_t node) {
+Expected<std::uint32_t> StreamedModelWriter::addLeaf(const Mesh& g, std::uint32_t node) {
     State& s = *s_;
     const auto tmp = tmpPath(s.geometryPath);
     if (s.leaves.size() >= 0xFFFFFFFEu) return Error{"geometry file " + tmp.string() + ": too many leaves", ErrorCode::BadArgument};

@@ -445,7 +445,7 @@ Status Builder::buildInMemory(Work& w) {
     // is closed, and the whole is never in memory to tell.
     std::vector<LocalBsp> leaves = subdivisionLeafModels(mesh, *sub, FaceMode::TwoSided);
     std::size_t next = 0;
-    LeafGeometry g;
+    Mesh g;
     for (std::uint32_t i = 0; i < sub->nodes.size(); ++i) {
         const SubdivisionNode& s = sub->nodes[i];
         if (!s.isLeaf() || s.triangleCount == 0) continue;

@@ -14,6 +14,7 @@
 #include "dyncull/loaders/loaders.hpp"
 #include "dyncull/loaders/ply_stream.hpp"
 #include "dyncull/objects/checksum.hpp"
+#include "dyncull/streaming/leaf_cache.hpp"
 #include "dyncull/streaming/out_of_core_subdivision.hpp"
 #include "dyncull/streaming/streamed_model.hpp"
 #include "objects/test_files.hpp"
@@ -79,7 +80,7 @@ std::vector<Tri> readAll(const StreamedModel& model, std::uint32_t maxLeaf) {
     auto file = GeometryFile::open(model);
     EXPECT_TRUE(file.ok()) << file.error().message;
     std::vector<Tri> out;
-    LeafGeometry g;
+    Mesh g;
     std::vector<unsigned char> scratch;
     for (std::uint32_t i = 0; i < model.leaves.size(); ++i) {
         const Status s = file->read(i, g, scratch);
@@ -146,7 +147,7 @@ TEST(OutOfCoreSubdivision, NormalsAreTheMeshsOwnWhetherGivenOrComputed) {
         std::map<std::array<float, 3>, glm::vec3> expected;
         for (std::size_t v = 0; v < withNormals.positions.size(); ++v)
             expected[{withNormals.positions[v].x, withNormals.positions[v].y, withNormals.positions[v].z}] = withNormals.normals[v];
-        LeafGeometry g;
+        Mesh g;
         std::vector<unsigned char> scratch;
         for (std::uint32_t i = 0; i < model->leaves.size(); ++i) {
             ASSERT_TRUE(file->read(i, g, scratch).ok());
@@ -329,7 +330,7 @@ TEST_F(StreamedModelFiles, ACorruptChunkIsAnErrorNamingTheLeafAndOnlyThatLeaf) {
     writeBytes(geometry_, b);
     auto file = GeometryFile::open(*model);
     ASSERT_TRUE(file.ok());
-    LeafGeometry g;
+    Mesh g;
     std::vector<unsigned char> scratch;
     for (std::uint32_t i = 0; i < model->leaves.size(); ++i) {
         const Status s = file->read(i, g, scratch);
@@ -343,6 +344,129 @@ TEST_F(StreamedModelFiles, ACorruptChunkIsAnErrorNamingTheLeafAndOnlyThatLeaf) {
         EXPECT_EQ(s.error().code, ErrorCode::BadFile);
     }
     EXPECT_FALSE(file->read(static_cast<std::uint32_t>(model->leaves.size()), g, scratch).ok());
+}
+
+}  // namespace
+}  // namespace dyncull
+
+namespace dyncull {
+namespace {
+
+class LeafCacheTest : public ::testing::Test {
+protected:
+    void SetUp() override {
+        const Mesh mesh = sphereField(3, 16, 24);
+        ASSERT_TRUE(subdivideOutOfCore(meshSource(mesh), dir_.file("m.dnodes"), smallBudget(300)).ok());
+        auto m = readStreamedModel(dir_.file("m.dnodes"));
+        ASSERT_TRUE(m.ok());
+        model_ = m.take();
+        auto file = GeometryFile::open(model_);
+        ASSERT_TRUE(file.ok());
+        std::vector<unsigned char> scratch;
+        for (std::uint32_t i = 0; i < model_.leaves.size(); ++i) {
+            Mesh g;
+            ASSERT_TRUE(file->read(i, g, scratch).ok());
+            total_ += leafBytes(g);
+            largest_ = std::max(largest_, leafBytes(g));
+            truth_.push_back(std::move(g));
+        }
+        ASSERT_GE(truth_.size(), 8u);
+    }
+    test::TempDir dir_;
+    StreamedModel model_;
+    std::vector<Mesh> truth_;
+    std::size_t total_ = 0, largest_ = 0;
+};
+
+TEST_F(LeafCacheTest, ReadAheadAndDemandLoadsStayWithinTheBudget) {
+    const std::size_t budget = std::max(total_ / 4, 2 * largest_);
+    auto cache = LeafCache::create(model_, budget);
+    ASSERT_TRUE(cache.ok()) << cache.error().message;
+    std::vector<std::uint32_t> all(truth_.size());
+    for (std::uint32_t i = 0; i < all.size(); ++i) all[i] = i;
+    (*cache)->prefetch(all);
+    (*cache)->drain();
+    LeafCacheStats s = (*cache)->stats();
+    EXPECT_GT(s.prefetchLoads, 0u);
+    EXPECT_LT(s.prefetchLoads, all.size()) << "read-ahead stops where the budget is full";
+    EXPECT_EQ(s.evictions, 0u) << "read-ahead never evicts leaves earlier in its own list";
+    // The leaves read ahead are hits; every leaf comes back exact, in any order.
+    for (std::uint32_t k = 0; k < all.size(); ++k) {
+        const std::uint32_t leaf = (k * 7) % static_cast<std::uint32_t>(all.size());
+        auto g = (*cache)->acquire(leaf);
+        ASSERT_TRUE(g.ok()) << g.error().message;
+        EXPECT_EQ((*g)->positions, truth_[leaf].positions);
+        EXPECT_EQ((*g)->indices, truth_[leaf].indices);
+        (*cache)->release(leaf);
+        ASSERT_LE((*cache)->stats().residentBytes, budget);
+    }
+    s = (*cache)->stats();
+    EXPECT_GT(s.hits, 0u);
+    EXPECT_GT(s.misses, 0u);
+    EXPECT_EQ(s.hits + s.misses, all.size());
+    EXPECT_GT(s.evictions, 0u);
+    EXPECT_LE(s.peakResidentBytes, budget);
+}
+
+TEST_F(LeafCacheTest, PinnedLeavesStayAndAFullBudgetOfPinsIsAnError) {
+    auto cache = LeafCache::create(model_, 3 * largest_);
+    ASSERT_TRUE(cache.ok());
+    auto a = (*cache)->acquire(0);
+    auto b = (*cache)->acquire(1);
+    ASSERT_TRUE(a.ok() && b.ok());
+    const Mesh* pa = *a;
+    // Other leaves come and go through the one free slot; the pinned two stay untouched.
+    for (std::uint32_t i = 2; i < truth_.size(); ++i) {
+        auto g = (*cache)->acquire(i);
+        ASSERT_TRUE(g.ok()) << g.error().message;
+        (*cache)->release(i);
+    }
+    EXPECT_TRUE((*cache)->resident(0) && (*cache)->resident(1));
+    EXPECT_EQ(pa->positions, truth_[0].positions);
+    // Pin a third leaf, then ask for a fourth: no room, and nothing pinned may go.
+    auto c = (*cache)->acquire(2);
+    ASSERT_TRUE(c.ok());
+    std::uint32_t big = 3;
+    for (std::uint32_t i = 3; i < truth_.size(); ++i)
+        if (leafBytes(truth_[i]) > leafBytes(truth_[big])) big = i;
+    const std::size_t used = leafBytes(truth_[0]) + leafBytes(truth_[1]) + leafBytes(truth_[2]);
+    if (used + leafBytes(truth_[big]) > 3 * largest_) {
+        auto d = (*cache)->acquire(big);
+        ASSERT_FALSE(d.ok());
+        EXPECT_EQ(d.error().code, ErrorCode::OutOfMemory);
+    }
+    (*cache)->release(0);
+    auto d = (*cache)->acquire(big);
+    EXPECT_TRUE(d.ok()) << "room once a pin is released";
+}
+
+TEST_F(LeafCacheTest, ALeafLargerThanTheBudgetIsAnErrorNamingIt) {
+    auto cache = LeafCache::create(model_, largest_ - 1);
+    ASSERT_FALSE(cache.ok());
+    EXPECT_NE(cache.error().message.find("more than the whole budget"), std::string::npos) << cache.error().message;
+}
+
+TEST_F(LeafCacheTest, ReadAheadAndTheRenderThreadAtOnce) {
+    auto cache = LeafCache::create(model_, std::max(total_ / 3, 2 * largest_));
+    ASSERT_TRUE(cache.ok());
+    std::vector<std::uint32_t> order(truth_.size());
+    for (int round = 0; round < 20; ++round) {
+        for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = (i * 5 + static_cast<std::uint32_t>(round)) % order.size();
+        (*cache)->prefetch(order);
+        for (std::uint32_t k = 0; k < 6; ++k) {
+            const std::uint32_t leaf = order[(k * 11) % order.size()];
+            if (const Mesh* g = (*cache)->tryAcquire(leaf)) {
+                EXPECT_EQ(g->indices.size(), truth_[leaf].indices.size());
+                (*cache)->release(leaf);
+            }
+            auto g = (*cache)->acquire(leaf);
+            ASSERT_TRUE(g.ok()) << g.error().message;
+            EXPECT_EQ((*g)->positions, truth_[leaf].positions);
+            (*cache)->release(leaf);
+        }
+    }
+    (*cache)->drain();
+    EXPECT_LE((*cache)->stats().peakResidentBytes, (*cache)->budget());
 }
 
 }  // namespace

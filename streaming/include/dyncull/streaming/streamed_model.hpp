@@ -32,6 +32,7 @@
 #include "dyncull/bsp/subdivision.hpp"
 #include "dyncull/objects/aabb.hpp"
 #include "dyncull/objects/error.hpp"
+#include "dyncull/objects/mesh.hpp"
 #include "dyncull/objects/obb.hpp"
 
 namespace dyncull {
@@ -41,16 +42,9 @@ inline constexpr std::size_t kStreamedHeaderSize = 48;
 /// Largest chunk a reader accepts: a leaf is meant to be loaded whole and fast.
 inline constexpr std::uint32_t kMaxLeafChunkBytes = 256u << 20;
 
-/// One leaf's geometry in its own compact vertex numbering, in model space (the space of
-/// the source file; the objects made from it have identity transforms).
-struct LeafGeometry {
-    std::vector<glm::vec3> positions;
-    std::vector<glm::vec3> normals;  ///< unit, one per position
-    std::vector<std::uint32_t> indices;  ///< 3 per triangle, each < positions.size()
-    std::size_t bytes() const {
-        return (positions.size() + normals.size()) * sizeof(glm::vec3) + indices.size() * sizeof(std::uint32_t);
-    }
-};
+/// Main-memory bytes of a leaf's geometry as read (positions, normals, indices): what the
+/// streaming budgets count.
+std::size_t leafBytes(const Mesh& leaf);
 
 /// Where a leaf's geometry is, and the volumes the scheduler tests before loading it.
 struct StreamedLeaf {
@@ -102,7 +96,9 @@ public:
     /// `node`, with its box and PCA box computed from the positions. Returns the leaf's
     /// index. Errors: empty or malformed geometry, more than 2^32-1 of anything, a chunk
     /// above kMaxLeafChunkBytes, a failed write.
-    Expected<std::uint32_t> addLeaf(const LeafGeometry& geometry, std::uint32_t node);
+    /// `geometry`: the leaf in its own compact vertex numbering, model space, one unit
+    /// normal per vertex.
+    Expected<std::uint32_t> addLeaf(const Mesh& geometry, std::uint32_t node);
     const std::vector<StreamedLeaf>& leaves() const;
     std::uint64_t geometryBytes() const;
 
@@ -134,7 +130,8 @@ public:
     /// Reads leaf `leaf` into `out` (its vectors reused). The chunk's checksum, counts,
     /// index range, finite values and containment in the leaf's box are checked; the
     /// error names the file and the leaf. `scratch` holds the raw chunk between calls.
-    Status read(std::uint32_t leaf, LeafGeometry& out, std::vector<unsigned char>& scratch) const;
+    /// `out` gets positions, unit normals and indices (model space; its name is left alone).
+    Status read(std::uint32_t leaf, Mesh& out, std::vector<unsigned char>& scratch) const;
     std::uint32_t leafCount() const;
 
 private:

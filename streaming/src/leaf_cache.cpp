@@ -1,0 +1,216 @@
+// LeafCache (leaf_cache.hpp). One mutex guards the residency table; chunks are read and
+// decoded outside it, so the render thread's hits never wait for the disk.
+// Paper: Out-of-core interactive display of large meshes using an oriented bounding
+// box-based hardware depth query, section 5 (LRU replacement of per-node memory).
+#include "dyncull/streaming/leaf_cache.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace dyncull {
+
+struct LeafCache::State {
+    GeometryFile file;
+    std::vector<StreamedLeaf> leaves;  // the node file's table (chunk sizes, for the budget)
+    std::size_t budget = 0;
+
+    mutable std::mutex mutex;
+    std::condition_variable wake, idle, loaded;
+    struct Entry {
+        std::unique_ptr<Mesh> mesh;  // null: not resident
+        std::uint32_t pins = 0;
+        std::uint64_t used = 0;      // clock of the last acquire or prefetch
+        bool loading = false;        // being read by some thread
+    };
+    std::vector<Entry> entries;
+    std::vector<std::uint32_t> wanted;  // the read-ahead list
+    std::vector<std::uint8_t> protect;  // per leaf: in the read-ahead list before the current position
+    std::size_t next = 0;               // position in `wanted`
+    std::uint64_t clock = 0;
+    bool busy = false, stop = false;
+    LeafCacheStats stats;
+    std::thread loader;
+
+    explicit State(GeometryFile f) : file(std::move(f)) {}
+
+    /// Bytes a leaf will take once read: known from the node file without reading it.
+    std::size_t bytesOf(std::uint32_t leaf) const {
+        const StreamedLeaf& l = leaves[leaf];
+        return std::size_t{l.vertexCount} * 24 + std::size_t{l.triangleCount} * 12;
+    }
+    /// Evicts least-recently-used leaves that are neither pinned nor loading until `bytes`
+    /// more fit; leaves earlier in the read-ahead list go only for a leaf needed now
+    /// (`demand`). Lock held. false if they cannot be made to fit. A linear scan: leaves
+    /// number tens of thousands, and an eviction reads a chunk, which costs far more.
+    bool makeRoom(std::size_t bytes, bool demand) {
+        while (stats.residentBytes + bytes > budget) {
+            std::size_t victim = SIZE_MAX;
+            for (int pass = 0; pass < (demand ? 2 : 1) && victim == SIZE_MAX; ++pass)
+                for (std::size_t i = 0; i < entries.size(); ++i) {
+                    const Entry& e = entries[i];
+                    if (!e.mesh || e.pins || (pass == 0 && protect[i])) continue;
+                    if (victim == SIZE_MAX || e.used < entries[victim].used) victim = i;
+                }
+            if (victim == SIZE_MAX) return false;
+            stats.residentBytes -= leafBytes(*entries[victim].mesh);
+            entries[victim].mesh.reset();
+            ++stats.evictions;
+        }
+        return true;
+    }
+    /// Reads a leaf outside the lock (the caller marked it loading, and unlocks around
+    /// this), then publishes it if room allows. Lock held on entry and exit.
+    Status load(std::unique_lock<std::mutex>& lock, std::uint32_t leaf, bool prefetching) {
+        const std::size_t bytes = bytesOf(leaf);
+        if (!makeRoom(bytes, !prefetching)) return Error{"leaf cache: the budget is full of leaves in use", ErrorCode::OutOfMemory};
+        // Reserve the bytes before reading, so two threads cannot both count on them.
+        stats.residentBytes += bytes;
+        entries[leaf].loading = true;
+        lock.unlock();
+        auto mesh = std::make_unique<Mesh>();
+        std::vector<unsigned char> scratch;
+        const Status st = file.read(leaf, *mesh, scratch);
+        lock.lock();
+        entries[leaf].loading = false;
+        loaded.notify_all();
+        if (!st) {
+            stats.residentBytes -= bytes;
+            return st;
+        }
+        entries[leaf].mesh = std::move(mesh);
+        ++stats.loads;
+        if (prefetching) ++stats.prefetchLoads;
+        stats.bytesRead += leaves[leaf].chunkBytes;
+        stats.peakResidentBytes = std::max(stats.peakResidentBytes, stats.residentBytes);
+        return {};
+    }
+    void run() {
+        std::unique_lock lock(mutex);
+        for (;;) {
+            wake.wait(lock, [&] { return stop || next < wanted.size(); });
+            if (stop) return;
+            busy = true;
+            const std::uint32_t leaf = wanted[next];
+            protect[leaf] = 1;
+            ++next;
+            Entry& e = entries[leaf];
+            e.used = ++clock;
+            if (!e.mesh && !e.loading) {
+                // Full of wanted leaves: nothing further down the list may displace them. (A
+                // bad chunk is skipped here and reported when the leaf is acquired.)
+                if (Status st = load(lock, leaf, true); !st && st.error().code == ErrorCode::OutOfMemory)
+                    next = wanted.size();
+            }
+            busy = next < wanted.size();
+            if (!busy) idle.notify_all();
+        }
+    }
+};
+
+LeafCache::LeafCache(std::unique_ptr<State> s) : s_(std::move(s)) {
+    s_->loader = std::thread([st = s_.get()] { st->run(); });
+}
+
+LeafCache::~LeafCache() {
+    {
+        std::lock_guard lock(s_->mutex);
+        s_->stop = true;
+    }
+    s_->wake.notify_all();
+    s_->loader.join();
+}
+
+Expected<std::unique_ptr<LeafCache>> LeafCache::create(const StreamedModel& model, std::size_t budgetBytes) {
+    auto file = GeometryFile::open(model);
+    if (!file) return file.error();
+    auto s = std::make_unique<State>(file.take());
+    s->leaves = model.leaves;
+    s->budget = budgetBytes;
+    for (std::uint32_t i = 0; i < s->leaves.size(); ++i)
+        if (s->bytesOf(i) > budgetBytes)
+            return Error{"leaf " + std::to_string(i) + " of " + model.nodePath.string() + " needs " +
+                             std::to_string((s->bytesOf(i) + (1 << 20) - 1) >> 20) + " MB, more than the whole budget of " +
+                             std::to_string(budgetBytes >> 20) + " MB",
+                         ErrorCode::BadArgument};
+    s->entries.resize(s->leaves.size());
+    s->protect.assign(s->leaves.size(), 0);
+    return std::unique_ptr<LeafCache>(new LeafCache(std::move(s)));
+}
+
+void LeafCache::prefetch(std::span<const std::uint32_t> leaves) {
+    {
+        std::lock_guard lock(s_->mutex);
+        std::fill(s_->protect.begin(), s_->protect.end(), 0);
+        s_->wanted.clear();
+        for (std::uint32_t l : leaves)
+            if (l < s_->entries.size()) s_->wanted.push_back(l);
+        s_->next = 0;
+    }
+    s_->wake.notify_all();
+}
+
+Expected<const Mesh*> LeafCache::acquire(std::uint32_t leaf) {
+    State& s = *s_;
+    if (leaf >= s.entries.size()) return Error{"leaf cache: no leaf " + std::to_string(leaf), ErrorCode::BadArgument};
+    std::unique_lock lock(s.mutex);
+    State::Entry& e = s.entries[leaf];
+    e.used = ++s.clock;
+    if (e.mesh) {
+        ++s.stats.hits;
+        ++e.pins;
+        return e.mesh.get();
+    }
+    ++s.stats.misses;
+    const auto t0 = std::chrono::steady_clock::now();
+    // The loader thread is reading it: wait for that read rather than read it twice.
+    s.loaded.wait(lock, [&] { return !e.loading; });
+    Status st;
+    if (!e.mesh) st = s.load(lock, leaf, false);
+    s.stats.stallMs += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    if (!st) return st.error();
+    ++e.pins;
+    return e.mesh.get();
+}
+
+const Mesh* LeafCache::tryAcquire(std::uint32_t leaf) {
+    State& s = *s_;
+    if (leaf >= s.entries.size()) return nullptr;
+    std::lock_guard lock(s.mutex);
+    State::Entry& e = s.entries[leaf];
+    e.used = ++s.clock;
+    if (!e.mesh) {
+        ++s.stats.misses;
+        return nullptr;
+    }
+    ++s.stats.hits;
+    ++e.pins;
+    return e.mesh.get();
+}
+
+void LeafCache::release(std::uint32_t leaf) {
+    std::lock_guard lock(s_->mutex);
+    if (leaf < s_->entries.size() && s_->entries[leaf].pins > 0) --s_->entries[leaf].pins;
+}
+
+bool LeafCache::resident(std::uint32_t leaf) const {
+    std::lock_guard lock(s_->mutex);
+    return leaf < s_->entries.size() && s_->entries[leaf].mesh != nullptr;
+}
+
+void LeafCache::drain() {
+    std::unique_lock lock(s_->mutex);
+    s_->idle.wait(lock, [&] { return s_->next >= s_->wanted.size() && !s_->busy; });
+}
+
+LeafCacheStats LeafCache::stats() const {
+    std::lock_guard lock(s_->mutex);
+    return s_->stats;
+}
+
+std::size_t LeafCache::budget() const { return s_->budget; }
+
+}  // namespace dyncull
