@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <system_error>
 
 #include <CLI/CLI.hpp>
@@ -88,6 +89,15 @@ Status ensureParentDirectory(const std::filesystem::path& file) {
 void fail(const std::string& message) {
     std::fprintf(stderr, "error: %s\n", message.c_str());
     throw CLI::RuntimeError(1);
+}
+
+std::size_t procStatusBytes(const char* key) {
+    std::ifstream f("/proc/self/status");
+    std::string line;
+    const std::string k(key);
+    while (std::getline(f, line))
+        if (line.rfind(k, 0) == 0) return std::stoull(line.substr(k.size() + 1)) * 1024;
+    return 0;
 }
 
 }  // namespace dyncull::cli

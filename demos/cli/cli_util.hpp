@@ -36,6 +36,10 @@ const std::string& commandLine();
 /// Prints "error: <message>" on stderr and exits the subcommand with code 1.
 [[noreturn]] void fail(const std::string& message);
 
+/// A "VmRSS:"/"VmHWM:" line of /proc/self/status in bytes (current and peak resident set),
+/// or 0 where there is none (not Linux).
+std::size_t procStatusBytes(const char* key);
+
 /// Milliseconds since construction or the last lap().
 class Stopwatch {
 public:

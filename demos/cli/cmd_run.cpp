@@ -11,6 +11,7 @@
 #include <string>
 
 #include "cli_util.hpp"
+#include "streaming_report.hpp"
 #include "commands.hpp"
 #include "crash_report.hpp"
 #include "dyncull/viewer/window_context.hpp"
@@ -127,6 +128,7 @@ void runRun(RunOptions o) {
     if (defaultScreenshot && std::filesystem::is_regular_file(o.screenshot, ec)) std::filesystem::remove(o.screenshot, ec);
 
     double ms = 0, queries = 0, parts = 0, triangles = 0;
+    StreamingSummary streaming;
     std::vector<std::string> written;
     const float aspect = static_cast<float>(size->x) / static_cast<float>(size->y);
     auto writeShot = [&](const std::string& path) {
@@ -145,10 +147,14 @@ void runRun(RunOptions o) {
             fail(o.scene + ": frame " + std::to_string(frame) + ": the scene's camera path gives an unusable camera (" +
                  s.message() + ")" + (o.sceneOptions.bunny.orbit > 0.0f ? "; check --orbit" : ""));
         if (boxView) boxView->trace(engine.scheduler(), true);
+        scene.beginFrame(engine.camera());
         ctx.clearFramebuffer(Renderer::kClearColour);
         auto rendered = engine.renderFrame();
         if (!rendered) fail("frame " + std::to_string(frame) + ": " + rendered.error().message);
         const FrameStats& st = *rendered;
+        auto streamed = scene.endFrame();
+        if (!streamed) fail("frame " + std::to_string(frame) + ": " + streamed.error().message);
+        if (*streamed) streaming.add(frame, **streamed, st.frameMs);
         if (boxView) drawNodeBoxOverlay(*boxView, engine, st, o.mode);
         writeCsvRow(csv, frame, st);
         // Every row reaches the file as its frame ends, so an interrupted run keeps them.
@@ -188,6 +194,11 @@ void runRun(RunOptions o) {
                 "parts_per_frame=%.1f triangles_per_frame=%.0f\n",
                 scene.name().c_str(), o.mode.c_str(), o.flags.volume.c_str(), static_cast<unsigned long long>(frame),
                 ms / n, queries / n, parts / n, triangles / n);
+    if (streaming.frames > 0) {
+        const std::string path = o.out + "/streaming.csv";
+        if (Status s = streaming.writeCsv(path); !s) fail(s.message());
+        std::printf("streaming stats: %s\n%s\n", path.c_str(), streaming.line(o.sceneOptions.stream).c_str());
+    }
     if (interrupted) throw CLI::RuntimeError(128 + interruptSignal());
 }
 

@@ -31,15 +31,6 @@ struct SubdivideCommandOptions {
     SceneOptions sceneOptions;
 };
 
-/// A "VmRSS"/"VmHWM" line of /proc/self/status in bytes, or 0 where there is none (not Linux).
-std::size_t procStatusBytes(const char* key) {
-    std::ifstream f("/proc/self/status");
-    std::string line;
-    while (std::getline(f, line))
-        if (line.rfind(key, 0) == 0) return std::stoull(line.substr(std::string(key).size() + 1)) * 1024;
-    return 0;
-}
-
 /// Resets the peak resident size (VmHWM) to the current one (Linux >= 4.0); false if unavailable.
 bool resetPeakRss() {
     std::ofstream f("/proc/self/clear_refs");

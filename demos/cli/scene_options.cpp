@@ -91,6 +91,21 @@ void addGeneratedSceneOptions(CLI::App& cmd, SceneOptions& o) {
     cmd.add_option("--collapse", o.subdivide.collapseTo, "--subdivide: at most this many children per node (0 keeps the tree)")
         ->check(wholeIn(0, 1000000))
         ->capture_default_str();
+    cmd.add_option("--memory-mb", o.stream.memoryMb,
+                   "stream the geometry under this main-memory budget: a .dnodes file, or powerplant/city (preprocessed "
+                   "out of core on first use and cached)")
+        ->check(wholeIn(1, 1 << 20));
+    cmd.add_option("--gpu-memory-mb", o.stream.gpuMemoryMb, "streaming: GL-buffer budget for leaf geometry (0: no limit)")
+        ->check(wholeIn(0, 1 << 20))
+        ->capture_default_str();
+    cmd.add_option("--stream-late", o.stream.late,
+                   "streaming: a visible leaf not in memory is waited for (wait: conservative), drawn the first frame "
+                   "it is read (draw), or left to the read-ahead (skip)")
+        ->check(CLI::IsMember({"wait", "draw", "skip"}))
+        ->capture_default_str();
+    cmd.add_option("--camera-of", o.stream.cameraOf, "streaming: fly this built-in scene's camera path (powerplant, city)")
+        ->check(CLI::IsMember({"powerplant", "city"}));
+    cmd.add_flag("--in-core", o.stream.inCore, "a .dnodes file read whole at start: the in-core reference of a streamed run");
 }
 
 void addSchedulerOptions(CLI::App& cmd, SchedulerFlags& f) {

@@ -1,5 +1,7 @@
 // Any PLY/OBJ/glTF file as a static scene through the same pipeline as dynamic ones:
 // one local BSP per mesh, one static object per instance, an automatic camera path.
+#include <unistd.h>
+
 #include <chrono>
 #include <filesystem>
 
@@ -111,6 +113,21 @@ Expected<std::unique_ptr<DemoScene>> makeScene(const std::string& nameOrPath, co
 Expected<std::unique_ptr<DemoScene>> makeScene(const std::string& nameOrPath, const SceneOptions& options) {
     // Before the built-in names: --subdivide applies to the power plant and the city too.
     if (std::filesystem::path(nameOrPath).extension() == ".dsub") return makeSubdivisionFileScene(nameOrPath, options);
+    if (std::filesystem::path(nameOrPath).extension() == ".dnodes") {
+        if (options.stream.memoryMb == 0 && !options.stream.inCore)
+            return Error{nameOrPath + ": a streamed model needs --memory-mb N (or --in-core to read it whole)", ErrorCode::BadArgument};
+        return makeStreamedScene(nameOrPath, options);
+    }
+    if (options.stream.memoryMb > 0) {
+        if (nameOrPath != "powerplant" && nameOrPath != "city")
+            return Error{"--memory-mb streams powerplant, city or a .dnodes file from `dyncull subdivide --memory-mb`",
+                         ErrorCode::BadArgument};
+        char exe[4096];
+        const ssize_t n = ::readlink("/proc/self/exe", exe, sizeof exe - 1);
+        if (n <= 0) return Error{"cannot find this program to preprocess " + nameOrPath, ErrorCode::Io};
+        exe[n] = '\0';
+        return makeStreamedBuiltin(nameOrPath, options, exe);
+    }
     if (!options.subdivide.method.empty()) {
         if (nameOrPath == "bunnies") return Error{"--subdivide: the bunny swarm is dynamic; subdivide a static scene"};
         if (!std::filesystem::exists(nameOrPath) && nameOrPath != "powerplant" && nameOrPath != "city")

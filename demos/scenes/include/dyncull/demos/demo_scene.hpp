@@ -6,12 +6,14 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "dyncull/bsp/subdivision.hpp"
 #include "dyncull/bsp/subdivision_file.hpp"
 #include "dyncull/engine/engine.hpp"
+#include "dyncull/engine/streamed_objects.hpp"
 #include "dyncull/objects/camera.hpp"
 #include "dyncull/objects/error.hpp"
 
@@ -32,6 +34,12 @@ public:
     virtual Camera camera(std::uint64_t frame, float aspect) const = 0;
     /// Frames of the default camera path.
     virtual std::uint64_t defaultFrames() const = 0;
+    /// Before each frame is rendered, with its camera (world space): a scene that streams
+    /// its geometry starts reading ahead for it.
+    virtual void beginFrame(const Camera& /*camera*/) {}
+    /// After each frame is rendered (every mode and view of it): a streaming scene's
+    /// counters for the frame, nothing for others. Error: a corrupt leaf met while drawing.
+    virtual Expected<std::optional<StreamingFrameStats>> endFrame() { return std::optional<StreamingFrameStats>{}; }
     /// Set-up time (loading, subdivision, local BSP builds), ms, filled by populate.
     double setupMs() const { return setupMs_; }
 
@@ -132,6 +140,20 @@ struct SubdivideOptions {
     unsigned threads = 2;
 };
 
+/// Streaming a model larger than memory (`--memory-mb`): a .dnodes file, or a built-in
+/// static scene preprocessed out of core on first use and cached.
+struct StreamOptions {
+    std::uint32_t memoryMb = 0;     ///< main-memory budget for leaf geometry; 0: not streamed
+    std::uint32_t gpuMemoryMb = 64; ///< GL-buffer budget for leaf geometry; 0: no limit
+    std::string late = "wait";      ///< StreamLate: wait, draw or skip
+    /// The built-in scene whose camera path a streamed file flies ("powerplant", "city");
+    /// empty: the file's own source decides, else the automatic camera of its bounds.
+    std::string cameraOf;
+    /// A .dnodes file read whole at start (every leaf resident, no budget): the in-core
+    /// reference of the same objects and draws.
+    bool inCore = false;
+};
+
 /// Options of every built-in scene, for makeScene.
 struct SceneOptions {
     BunnySwarmOptions bunny;
@@ -140,6 +162,7 @@ struct SceneOptions {
     SceneCacheOptions cache;  ///< copied into plant and city by makeScene
     std::string sceneDir;     ///< "powerplant" with a directory: load its PLY/OBJ parts instead
     SubdivideOptions subdivide;  ///< method set: static scenes are subdivided into objects
+    StreamOptions stream;        ///< memoryMb set: static scenes stream their geometry
 };
 
 /// A static scene source as one triangle soup (instances applied): "powerplant" or "city"
@@ -163,6 +186,15 @@ Expected<SubdividedModel> subdivideStaticScene(const std::string& nameOrPath, co
 /// static object of the global loose BSP; the camera path is the source's own (built-in
 /// scenes) or the automatic one of file scenes. Named "<source>_<method>".
 std::unique_ptr<DemoScene> makeSubdividedScene(const std::string& nameOrPath, const SceneOptions& options);
+
+/// A streamed model (`dyncull subdivide --memory-mb`, a .dnodes file) drawn under
+/// options.stream's budgets; its leaves are static objects of the loose BSP.
+std::unique_ptr<DemoScene> makeStreamedScene(const std::string& nodePath, const SceneOptions& options);
+/// `powerplant` or `city` streamed: the .dnodes file in the scene cache, made on first use
+/// by a child `dyncull subdivide --memory-mb` process (`exe`: this program), so this
+/// process never holds the whole model.
+Expected<std::unique_ptr<DemoScene>> makeStreamedBuiltin(const std::string& name, const SceneOptions& options,
+                                                          const std::string& exe);
 
 /// The same from a file written by `dyncull subdivide` (.dsub). A built-in source's
 /// camera needs the generator options the file was made with: others are an error.

@@ -1,0 +1,298 @@
+// StreamedObjects (streamed_objects.hpp): leaves as bounds-model objects, drawn through the
+// engine's draw callback from two residency levels: GL buffers (least recently drawn
+// released first) over a LeafCache in main memory.
+// Paper: Out-of-core interactive display of large meshes using an oriented bounding
+// box-based hardware depth query, section 5 (memory chunks per node, LRU replacement, two
+// reserve chunks for a node that finds none free: here a transient upload).
+#include "dyncull/engine/streamed_objects.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "dyncull/engine/renderer.hpp"
+
+namespace dyncull {
+
+const char* toString(StreamLate late) {
+    switch (late) {
+        case StreamLate::Wait: return "wait";
+        case StreamLate::Draw: return "draw";
+        case StreamLate::Skip: return "skip";
+    }
+    return "?";
+}
+
+Expected<StreamLate> parseStreamLate(const std::string& name) {
+    if (name == "wait") return StreamLate::Wait;
+    if (name == "draw") return StreamLate::Draw;
+    if (name == "skip") return StreamLate::Skip;
+    return Error{"unknown late-leaf policy '" + name + "' (wait, draw or skip)", ErrorCode::BadArgument};
+}
+
+struct StreamedObjects::State {
+    Engine& engine;
+    StreamingOptions options;
+    StreamedModel model;
+    std::unique_ptr<LeafCache> cache;
+    std::vector<std::uint32_t> leafOfSlot;  // object slot -> leaf (kInvalidIndex: not ours)
+    std::vector<ObjectHandle> objectOfLeaf;
+
+    struct Gpu {
+        MeshId mesh = 0;
+        bool resident = false;
+        std::uint64_t frame = 0;  // last frame it was drawn in
+        std::size_t bytes = 0;
+    };
+    std::vector<Gpu> gpu;
+    std::vector<std::uint32_t> gpuResident;  // leaves with GL buffers
+    std::size_t gpuBytes = 0, peakGpuBytes = 0;
+
+    std::uint64_t frame = 0;
+    std::vector<std::uint32_t> drawn, lastDrawn, urgent, wanted;
+    std::vector<std::uint8_t> listed;  // per leaf, while building `wanted`
+    std::vector<std::uint32_t> leafOfNode;
+    std::optional<Camera> previous;
+    StreamingFrameStats frameStats;
+    LeafCacheStats cacheAtStart;
+    std::optional<Error> error;
+
+    State(Engine& e, const StreamingOptions& o) : engine(e), options(o) {}
+
+    std::size_t gpuBudget() const { return options.gpuBytes ? options.gpuBytes : SIZE_MAX; }
+
+    /// Releases least recently drawn leaves not drawn this frame until `bytes` more fit.
+    bool makeGpuRoom(std::size_t bytes) {
+        while (gpuBytes + bytes > gpuBudget()) {
+            std::size_t victim = SIZE_MAX;
+            for (std::size_t k = 0; k < gpuResident.size(); ++k) {
+                const Gpu& g = gpu[gpuResident[k]];
+                if (g.frame == frame) continue;
+                if (victim == SIZE_MAX || g.frame < gpu[gpuResident[victim]].frame) victim = k;
+            }
+            if (victim == SIZE_MAX) return false;
+            Gpu& g = gpu[gpuResident[victim]];
+            engine.renderer().release(g.mesh);
+            g.resident = false;
+            gpuBytes -= g.bytes;
+            gpuResident[victim] = gpuResident.back();
+            gpuResident.pop_back();
+            ++frameStats.gpuEvictions;
+        }
+        return true;
+    }
+
+    void draw(ObjectHandle object, ModelId modelId, std::uint32_t first, std::uint32_t count, const glm::mat4& m) {
+        Renderer& r = engine.renderer();
+        const glm::vec3 colour = colourForId(object.index);
+        const std::uint32_t leaf = object.index < leafOfSlot.size() ? leafOfSlot[object.index] : kInvalidIndex;
+        if (leaf == kInvalidIndex) {  // another object of the engine: drawn as the engine would
+            r.drawRange(engine.meshOf(modelId), first, count, m, colour);
+            return;
+        }
+        Gpu& g = gpu[leaf];
+        if (g.frame != frame) drawn.push_back(leaf);
+        g.frame = frame;
+        if (g.resident) {
+            r.drawMesh(g.mesh, m, colour);
+            return;
+        }
+        const Mesh* mesh = nullptr;
+        if (options.late == StreamLate::Wait) {
+            auto got = cache->acquire(leaf);
+            if (!got) {
+                if (!error) error = got.error();
+                return;
+            }
+            mesh = *got;
+        } else {
+            mesh = cache->tryAcquire(leaf);
+            if (!mesh) {
+                ++frameStats.late;
+                if (options.late == StreamLate::Draw) urgent.push_back(leaf);
+                return;
+            }
+        }
+        const std::size_t bytes = leafBytes(*mesh);
+        const bool keep = makeGpuRoom(bytes);
+        auto uploaded = r.upload(*mesh, FaceMode::TwoSided);
+        cache->release(leaf);
+        if (!uploaded) {
+            if (!error) error = uploaded.error();
+            return;
+        }
+        ++frameStats.uploads;
+        r.drawMesh(*uploaded, m, colour);
+        if (!keep) {  // the GL budget is full of this frame's leaves: draw from a transient copy
+            r.release(*uploaded);
+            ++frameStats.overflow;
+            return;
+        }
+        g.mesh = *uploaded;
+        g.resident = true;
+        g.bytes = bytes;
+        gpuBytes += bytes;
+        peakGpuBytes = std::max(peakGpuBytes, gpuBytes);
+        gpuResident.push_back(leaf);
+    }
+
+    void want(std::uint32_t leaf) {
+        if (listed[leaf]) return;
+        listed[leaf] = 1;
+        wanted.push_back(leaf);
+    }
+};
+
+StreamedObjects::StreamedObjects(std::unique_ptr<State> s) : s_(std::move(s)) {}
+
+StreamedObjects::~StreamedObjects() = default;
+
+void StreamedObjects::detach() {
+    State& s = *s_;
+    s.engine.setDrawCallback(nullptr);
+    for (std::uint32_t leaf : s.gpuResident) {
+        s.engine.renderer().release(s.gpu[leaf].mesh);
+        s.gpu[leaf].resident = false;
+    }
+    s.gpuResident.clear();
+    s.gpuBytes = 0;
+}
+
+Expected<std::unique_ptr<StreamedObjects>> StreamedObjects::create(Engine& engine, const std::filesystem::path& nodePath,
+                                                                   const StreamingOptions& options) {
+    if (!engine.hasRenderer())
+        return Error{"streamed objects are drawn by the part renderer (EngineOptions::partRenderer)", ErrorCode::BadArgument};
+    if (!(options.widenFov >= 1.0f) || !std::isfinite(options.widenFov))
+        return Error{"widenFov must be at least 1", ErrorCode::BadArgument};
+    auto model = readStreamedModel(nodePath);
+    if (!model) return model.error();
+    auto s = std::make_unique<State>(engine, options);
+    s->model = model.take();
+    std::size_t total = 0, largest = 0;
+    for (const StreamedLeaf& l : s->model.leaves) {
+        const std::size_t b = std::size_t{l.vertexCount} * 24 + std::size_t{l.triangleCount} * 12;
+        total += b;
+        largest = std::max(largest, b);
+    }
+    if (options.gpuBytes && largest > options.gpuBytes)
+        return Error{nodePath.string() + ": its largest leaf needs " + std::to_string((largest >> 20) + 1) +
+                         " MB of GL buffers, more than the whole GPU budget of " + std::to_string(options.gpuBytes >> 20) +
+                         " MB",
+                     ErrorCode::BadArgument};
+    auto cache = LeafCache::create(s->model, options.memoryBytes ? options.memoryBytes : total);
+    if (!cache) return cache.error();
+    s->cache = cache.take();
+    const auto n = static_cast<std::uint32_t>(s->model.leaves.size());
+    s->gpu.resize(n);
+    s->listed.assign(n, 0);
+    s->leafOfNode.assign(s->model.nodes.size(), kInvalidIndex);
+    for (std::uint32_t i = 0; i < n; ++i) s->leafOfNode[s->model.leaves[i].node] = i;
+    s->objectOfLeaf.resize(n);
+    for (std::uint32_t i = 0; i < n; ++i) {
+        const StreamedLeaf& l = s->model.leaves[i];
+        auto id = engine.addBoundsModel(l.box, l.triangleCount);
+        if (!id) return id.error();
+        auto object = engine.addObject(*id, Transform{}, true);
+        if (!object) return object.error();
+        if (s->leafOfSlot.size() <= object->index) s->leafOfSlot.resize(object->index + 1, kInvalidIndex);
+        s->leafOfSlot[object->index] = i;
+        s->objectOfLeaf[i] = *object;
+    }
+    if (options.memoryBytes == 0) {  // in core: every leaf now, read by the loader thread
+        std::vector<std::uint32_t> all(n);
+        for (std::uint32_t i = 0; i < n; ++i) all[i] = i;
+        s->cache->prefetch(all);
+        s->cache->drain();
+    }
+    State* st = s.get();
+    engine.setDrawCallback([st](ObjectHandle object, ModelId modelId, std::uint32_t first, std::uint32_t count,
+                                const glm::mat4& m) { st->draw(object, modelId, first, count, m); });
+    s->cacheAtStart = s->cache->stats();
+    return std::unique_ptr<StreamedObjects>(new StreamedObjects(std::move(s)));
+}
+
+void StreamedObjects::beginFrame(const Camera& camera) {
+    State& s = *s_;
+    ++s.frame;
+    s.frameStats = StreamingFrameStats{};
+    s.cacheAtStart = s.cache->stats();
+    s.error.reset();
+    if (s.options.memoryBytes == 0) return;  // in core: everything is resident
+
+    // The camera moved on by its last motion, seeing wider: what the next frames may show.
+    Camera predicted = camera;
+    if (s.previous) {
+        const glm::vec3 motion = camera.position - s.previous->position;
+        predicted.position += motion;
+        predicted.target += motion;
+    }
+    predicted.fovYRadians = std::min(camera.fovYRadians * s.options.widenFov, 2.8f);
+    s.previous = camera;
+    const Frustum now = Frustum::fromCamera(camera), next = Frustum::fromCamera(predicted);
+
+    s.wanted.clear();
+    for (std::uint32_t leaf : s.urgent) s.want(leaf);
+    for (std::uint32_t leaf : s.lastDrawn) s.want(leaf);
+    // Leaves in either frustum, nearest first, through the tree (a subtree outside both is skipped).
+    struct Near {
+        float distance;
+        std::uint32_t leaf;
+    };
+    std::vector<Near> found;
+    std::vector<std::uint32_t> stack{0};
+    while (!stack.empty()) {
+        const std::uint32_t k = stack.back();
+        stack.pop_back();
+        const SubdivisionNode& node = s.model.nodes[k];
+        if (node.triangleCount == 0 || (now.outside(node.box) && next.outside(node.box))) continue;
+        if (!node.isLeaf()) {
+            for (std::uint32_t c = 0; c < node.childCount; ++c) stack.push_back(node.firstChild + c);
+            continue;
+        }
+        const glm::vec3 nearest = glm::clamp(camera.position, node.box.min, node.box.max);
+        found.push_back({glm::distance(nearest, camera.position), s.leafOfNode[k]});
+    }
+    std::sort(found.begin(), found.end(), [](const Near& a, const Near& b) { return a.distance < b.distance; });
+    for (const Near& f : found) s.want(f.leaf);
+    for (std::uint32_t leaf : s.wanted) s.listed[leaf] = 0;
+    s.urgent.clear();
+    s.cache->prefetch(s.wanted);
+}
+
+Expected<StreamingFrameStats> StreamedObjects::endFrame() {
+    State& s = *s_;
+    s.lastDrawn.swap(s.drawn);
+    s.drawn.clear();
+    const LeafCacheStats now = s.cache->stats();
+    StreamingFrameStats& f = s.frameStats;
+    f.memoryResidentBytes = now.residentBytes;
+    f.gpuResidentBytes = s.gpuBytes;
+    f.bytesRead = now.bytesRead - s.cacheAtStart.bytesRead;
+    f.loads = now.loads - s.cacheAtStart.loads;
+    f.evictions = now.evictions - s.cacheAtStart.evictions;
+    f.hits = now.hits - s.cacheAtStart.hits;
+    f.misses = now.misses - s.cacheAtStart.misses;
+    f.stallMs = now.stallMs - s.cacheAtStart.stallMs;
+    if (s.error) return *s.error;
+    return f;
+}
+
+const StreamedModel& StreamedObjects::model() const { return s_->model; }
+
+std::optional<std::uint32_t> StreamedObjects::leafOf(ObjectHandle object) const {
+    if (object.index >= s_->leafOfSlot.size() || s_->leafOfSlot[object.index] == kInvalidIndex) return std::nullopt;
+    const std::uint32_t leaf = s_->leafOfSlot[object.index];
+    if (!(s_->objectOfLeaf[leaf] == object)) return std::nullopt;
+    return leaf;
+}
+
+Status StreamedObjects::readLeaf(std::uint32_t leaf, Mesh& out) const {
+    auto file = GeometryFile::open(s_->model);
+    if (!file) return file.error();
+    std::vector<unsigned char> scratch;
+    return file->read(leaf, out, scratch);
+}
+
+const LeafCacheStats StreamedObjects::cacheStats() const { return s_->cache->stats(); }
+std::size_t StreamedObjects::peakGpuBytes() const { return s_->peakGpuBytes; }
+
+}  // namespace dyncull
