@@ -18,36 +18,13 @@
 #include "dyncull/streaming/out_of_core_subdivision.hpp"
 #include "dyncull/streaming/streamed_model.hpp"
 #include "objects/test_files.hpp"
+#include "streaming/streamed_test_models.hpp"
 
 namespace dyncull {
 namespace {
 
+using test::sphereField;
 using test::TempDir;
-
-/// `n` x `n` x 2 closed UV spheres of `rings` x `segments` quads (as triangles), with
-/// shared vertices: a scanned-like surface in many clumps.
-Mesh sphereField(int n, int rings, int segments) {
-    Mesh m;
-    m.name = "spheres";
-    for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j)
-            for (int k = 0; k < 2; ++k) {
-                const glm::vec3 c(3.0f * i, 3.0f * k, 3.0f * j);
-                const auto base = static_cast<std::uint32_t>(m.positions.size());
-                for (int r = 0; r <= rings; ++r)
-                    for (int s = 0; s < segments; ++s) {
-                        const float th = 3.14159265f * r / rings, ph = 6.2831853f * s / segments;
-                        m.positions.push_back(c + glm::vec3(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph)));
-                    }
-                for (int r = 0; r < rings; ++r)
-                    for (int s = 0; s < segments; ++s) {
-                        const std::uint32_t a = base + r * segments + s, b = base + r * segments + (s + 1) % segments;
-                        const std::uint32_t c2 = a + segments, d = b + segments;
-                        m.indices.insert(m.indices.end(), {a, c2, b, b, c2, d});
-                    }
-            }
-    return m;
-}
 
 using Tri = std::array<float, 9>;
 
