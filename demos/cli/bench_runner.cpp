@@ -327,6 +327,7 @@ Expected<std::unique_ptr<BenchRunner>> BenchRunner::create(Engine& engine, DemoS
     auto gt = GroundTruth::create(engine.context());
     if (!gt) return gt.error();
     r->groundTruth_ = gt.take();
+    r->groundTruth_->setMeshSubstitute(scene.truthGeometry());
     BenchResult& res = r->result_;
     res.modes = std::move(modes);
     res.scene = scene.name();
@@ -344,6 +345,7 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
     const float aspect = static_cast<float>(size.x) / static_cast<float>(size.y);
     if (Status s = scene_.update(engine_, frame); !s) return s;
     if (Status s = engine_.setCamera(scene_.camera(frame, aspect)); !s) return s;
+    scene_.beginFrame(engine_.camera());
 
     // Relink once for all modes, so no mode pays for the others' motion.
     FrameTruth ft;
@@ -406,6 +408,9 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
             ft.boundAuto = volumeBound(VolumeChoice::Auto);
         }
     }
+    auto streamed = scene_.endFrame();
+    if (!streamed) return streamed.error();
+    if (*streamed) result_.streaming.add(frame, **streamed, row[0].stats.frameMs);
     result_.truth.push_back(ft);
     result_.frames.push_back(std::move(row));
     return {};
@@ -562,13 +567,17 @@ Status runMeasurement(const MeasureOptions& o, std::vector<ModeSpec> modes, cons
     const std::vector<ModeSummary> summary = summarise(result);
     if (Status s = writeFramesCsv(result, dir / "frames.csv"); !s) return s;
     if (Status s = writeSummaryCsv(summary, dir / "summary.csv"); !s) return s;
+    if (result.streaming.frames > 0)
+        if (Status s = result.streaming.writeCsv(dir / "streaming.csv"); !s) return s;
     for (std::size_t m = 0; m < result.modes.size(); ++m) {
         const std::filesystem::path png = dir / ("last_" + result.modes[m].name + ".png");
         if (Status s = writePng((*runner)->lastImages()[m], png); !s) return s;
     }
     const PlotOutcome plots = writePlots(result, summary, dir);
     if (!plots.message.empty()) std::printf("%s\n", plots.message.c_str());
-    if (Status s = writeReport(result, summary, command, plots.pngs, dir / "report.md"); !s) return s;
+    const std::string streamingLine = result.streaming.frames > 0 ? result.streaming.line(o.sceneOptions.stream) : "";
+    if (Status s = writeReport(result, summary, command, plots.pngs, streamingLine, dir / "report.md"); !s) return s;
+    if (!streamingLine.empty()) std::printf("streaming stats: %s\n%s\n", (dir / "streaming.csv").c_str(), streamingLine.c_str());
     std::printf("wrote %s, %s, %s", (dir / "frames.csv").c_str(), (dir / "summary.csv").c_str(),
                 (dir / "report.md").c_str());
     for (const std::string& p : plots.pngs) std::printf(", %s", (dir / p).c_str());

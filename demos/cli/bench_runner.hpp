@@ -12,6 +12,7 @@
 
 #include "dyncull/bsp/volume_totals.hpp"
 #include "dyncull/demos/demo_scene.hpp"
+#include "streaming_report.hpp"
 #include "dyncull/engine/engine.hpp"
 #include "dyncull/measure/ground_truth.hpp"
 #include "dyncull/engine/image.hpp"
@@ -121,6 +122,8 @@ struct BenchResult {
     /// Per mode: world-space totals of the leaf query volumes at the last frame (the
     /// k-DOP paper's Table 5); leaves == 0 for modes that do not query node volumes.
     std::vector<LeafVolumeTotals> leafTotals;
+    /// Streaming scenes: residency and traffic per frame (all modes of the frame together).
+    StreamingSummary streaming;
 };
 
 /// Borrows the engine (already populated with `scene`) and the scene for its lifetime.

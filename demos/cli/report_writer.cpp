@@ -350,12 +350,21 @@ PlotOutcome writePlots(const BenchResult& r, const std::vector<ModeSummary>& sum
        << "     " << gpQuote((dir / "plot_pareto.dat").string())
        << " using 2:(atleast($3)) with points pt 6 ps 1.4 lc rgb '#1f77b4' title 'mode / setting', \\\n"
        << "     '' using 2:(atleast($3)):1 with labels left offset 0.8,0.6 notitle\n";
+    if (r.streaming.frames > 0)
+        gp << "set output " << gpQuote((dir / "resident_memory.png").string()) << "\n"
+           << "set title " << gpQuote("Resident memory (" + title + ")") << "\nset xlabel 'frame'\nset ylabel 'MB'\n"
+           << "unset logscale y\nset offsets 0, 0, 0, 0\nset yrange [0:*]\nset datafile separator ','\n"
+           << "sdata = " << gpQuote((dir / "streaming.csv").string()) << "\n"
+           << "plot sdata using 1:2 skip 1 with lines lw 2 title 'leaves in main memory', \\\n"
+           << "     sdata using 1:3 skip 1 with lines lw 2 title 'leaves in GL buffers', \\\n"
+           << "     sdata using 1:4 skip 1 with lines lw 2 title 'process resident set (RSS)'\n";
     if (Status s = closeChecked(gp, dir / "plots.gp"); !s) return skipped(s);
     const fs::path log = dir / "gnuplot.log";
     const std::string cmd = shellQuote(gnuplot) + " " + shellQuote((dir / "plots.gp").string()) + " > " +
                             shellQuote(log.string()) + " 2>&1";
     const int rc = std::system(cmd.c_str());
-    for (const char* png : {"time_per_frame.png", "parts_per_frame.png", "queries_per_frame.png", "speed_vs_accuracy.png"}) {
+    for (const char* png :
+         {"time_per_frame.png", "parts_per_frame.png", "queries_per_frame.png", "speed_vs_accuracy.png", "resident_memory.png"}) {
         std::error_code ec;
         if (fs::exists(dir / png, ec) && fs::file_size(dir / png, ec) > 0) out.pngs.push_back(png);
     }
@@ -473,7 +482,7 @@ void writeClaimTable(std::ostream& f, const std::vector<ModeSummary>& summary) {
 }
 
 Status writeReport(const BenchResult& r, const std::vector<ModeSummary>& summary, const std::string& command,
-                   const std::vector<std::string>& plots, const fs::path& path) {
+                   const std::vector<std::string>& plots, const std::string& streaming, const fs::path& path) {
     std::ofstream f;
     if (Status s = openChecked(f, path); !s) return s;
     double visible = 0, frustum = 0, gtMs = 0, updateMs = 0;
@@ -493,7 +502,11 @@ Status writeReport(const BenchResult& r, const std::vector<ModeSummary>& summary
       << "- loose-BSP relink: " << fmt(updateMs / n, 2) << " ms per frame, done once per frame before the modes "
       << "(not counted in any mode)\n"
       << "- modes run interleaved: per frame the scene moves once, then every mode renders that frame with its own "
-         "scheduler and history, vfc first (its image is the reference), the others in an order rotated every frame\n\n";
+         "scheduler and history, vfc first (its image is the reference), the others in an order rotated every frame\n";
+    if (!streaming.empty())
+        f << "- geometry streamed (per frame in streaming.csv; all modes of a frame share the caches): `" << streaming
+          << "`\n";
+    f << "\n";
     f << "| mode | ms/frame | median | vs vfc | vs oracle | parts drawn | triangles | queries | occluded | sched ms | query ms | wait ms |"
          " % px wrong (mean) | % px wrong (max) | frames wrong | false neg. (parts) | false neg. (px) |"
          " false pos./frame | largest wrong region (px) | timeouts |\n"

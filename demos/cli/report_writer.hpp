@@ -93,7 +93,8 @@ PlotOutcome writePlots(const BenchResult& result, const std::vector<ModeSummary>
 bool reportsVolumes(const BenchResult& result);
 
 /// DIR/report.md. `command` is the command line shown at the top; `plots` the PNGs to embed.
+/// `streaming`: the streaming summary line of a streaming scene, else empty.
 Status writeReport(const BenchResult& result, const std::vector<ModeSummary>& summary, const std::string& command,
-                   const std::vector<std::string>& plots, const std::filesystem::path& path);
+                   const std::vector<std::string>& plots, const std::string& streaming, const std::filesystem::path& path);
 
 }  // namespace dyncull::cli

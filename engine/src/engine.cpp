@@ -58,6 +58,7 @@ struct Engine::Sink final : PartSink {
         const bool occludee = objs.role(object) == OcclusionRole::OccludeeOnly;
         if (occludee) glDepthMask(GL_FALSE);
         const MeshId mesh = e.meshOfModel_[objs.modelOf(object)];
+        if (mesh == kNoMesh) return;  // a bounds model only the draw callback draws
         if (ranges.size() == 1)
             e.renderer_->drawRange(mesh, ranges[0].firstIndex, ranges[0].indexCount, objs.matrix(object), colour, markSlot);
         else
@@ -86,13 +87,16 @@ struct Engine::Sink final : PartSink {
         const SceneObjects& objs = e.objects_;
         for (std::uint32_t i = 0; i < parts.size(); ++i) {
             const std::uint32_t object = parts[i].part.object;
-            e.renderer_->testRange(e.meshOfModel_[objs.modelOf(object)], parts[i].firstIndex, parts[i].indexCount,
-                                   objs.matrix(object), i);
+            const MeshId mesh = e.meshOfModel_[objs.modelOf(object)];
+            if (mesh != kNoMesh)
+                e.renderer_->testRange(mesh, parts[i].firstIndex, parts[i].indexCount, objs.matrix(object), i);
         }
         glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
         glDepthMask(GL_TRUE);
         e.marks_->endTest();
         e.marks_->readTest(out);
+        for (std::uint32_t i = 0; i < parts.size(); ++i)  // nothing to test: visible, as it must be
+            if (e.meshOfModel_[objs.modelOf(parts[i].part.object)] == kNoMesh) out[i] = QueryResult::Visible;
     }
 };
 
@@ -211,17 +215,19 @@ Expected<ModelId> Engine::addModel(const Mesh& mesh, const LocalBspParams& param
     return addModel(bsp.take());
 }
 
-Expected<ModelId> Engine::addBoundsModel(const Aabb& bounds, std::uint32_t triangles) {
+Expected<ModelId> Engine::addBoundsModel(const Aabb& bounds, std::uint32_t triangles, bool uploadBox) {
     auto bsp = buildBoundsModel(bounds, triangles);
     if (!bsp) return bsp.error();
-    return addModel(bsp.take());
+    return addModel(bsp.take(), uploadBox);
 }
 
-Expected<ModelId> Engine::addModel(LocalBsp bsp) {
+Expected<ModelId> Engine::addModel(LocalBsp bsp) { return addModel(std::move(bsp), true); }
+
+Expected<ModelId> Engine::addModel(LocalBsp bsp, bool upload) {
     if (Status s = enterGl("adding a model"); !s) return s.error();
     // Upload first: if the GPU refuses, nothing has been registered yet.
-    MeshId mesh = 0;
-    if (renderer_) {
+    MeshId mesh = kNoMesh;
+    if (renderer_ && upload) {
         auto uploaded = renderer_->upload(bsp.mesh, bsp.faces);
         if (!uploaded) return uploaded.error();
         mesh = *uploaded;
@@ -251,7 +257,7 @@ Status Engine::removeModel(ModelId model) {
     }
     if (Status s = objects_.removeModel(model); !s) return s;
     if (renderer_) {
-        renderer_->release(meshOfModel_[model]);
+        if (meshOfModel_[model] != kNoMesh) renderer_->release(meshOfModel_[model]);
         if (Status s = leaveGl("removeModel"); !s) return s;
     }
     return {};

@@ -8,6 +8,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unordered_map>
+
+#include <epoxy/gl.h>
 
 #include "dyncull/engine/renderer.hpp"
 
@@ -36,6 +39,8 @@ struct StreamedObjects::State {
     std::unique_ptr<LeafCache> cache;
     std::vector<std::uint32_t> leafOfSlot;  // object slot -> leaf (kInvalidIndex: not ours)
     std::vector<ObjectHandle> objectOfLeaf;
+    std::optional<GeometryFile> truthFile;     // readLeaf's own handle, opened on first use
+    std::vector<unsigned char> truthScratch;
 
     struct Gpu {
         MeshId mesh = 0;
@@ -46,6 +51,7 @@ struct StreamedObjects::State {
     std::vector<Gpu> gpu;
     std::vector<std::uint32_t> gpuResident;  // leaves with GL buffers
     std::size_t gpuBytes = 0, peakGpuBytes = 0;
+    std::size_t transientBytes = 0;  // transient uploads since the last flush
 
     std::uint64_t frame = 0;
     std::vector<std::uint32_t> drawn, lastDrawn, urgent, wanted;
@@ -86,14 +92,16 @@ struct StreamedObjects::State {
         const glm::vec3 colour = colourForId(object.index);
         const std::uint32_t leaf = object.index < leafOfSlot.size() ? leafOfSlot[object.index] : kInvalidIndex;
         if (leaf == kInvalidIndex) {  // another object of the engine: drawn as the engine would
-            r.drawRange(engine.meshOf(modelId), first, count, m, colour);
+            if (engine.meshOf(modelId) != Engine::kNoMesh) r.drawRange(engine.meshOf(modelId), first, count, m, colour);
             return;
         }
+        // The leaf's geometry is in world space; `m` places the unit box that stands for it.
+        static const glm::mat4 identity(1.0f);
         Gpu& g = gpu[leaf];
         if (g.frame != frame) drawn.push_back(leaf);
         g.frame = frame;
         if (g.resident) {
-            r.drawMesh(g.mesh, m, colour);
+            r.drawMesh(g.mesh, identity, colour);
             return;
         }
         const Mesh* mesh = nullptr;
@@ -121,10 +129,17 @@ struct StreamedObjects::State {
             return;
         }
         ++frameStats.uploads;
-        r.drawMesh(*uploaded, m, colour);
+        r.drawMesh(*uploaded, identity, colour);
         if (!keep) {  // the GL budget is full of this frame's leaves: draw from a transient copy
             r.release(*uploaded);
             ++frameStats.overflow;
+            // A released buffer lives on until the draws using it have run: flushing now and
+            // then bounds the transient copies to a quarter of the budget (or 8 MB).
+            transientBytes += bytes;
+            if (transientBytes > std::max<std::size_t>(options.gpuBytes / 4, std::size_t{8} << 20)) {
+                glFlush();
+                transientBytes = 0;
+            }
             return;
         }
         g.mesh = *uploaded;
@@ -187,11 +202,26 @@ Expected<std::unique_ptr<StreamedObjects>> StreamedObjects::create(Engine& engin
     s->leafOfNode.assign(s->model.nodes.size(), kInvalidIndex);
     for (std::uint32_t i = 0; i < n; ++i) s->leafOfNode[s->model.leaves[i].node] = i;
     s->objectOfLeaf.resize(n);
+    // One unit-box model per triangle count, placed and sized by each object's transform:
+    // tens of thousands of leaves share a few hundred models (each model holds volumes,
+    // clusters and a tree), and the cost model still sees every leaf's own triangles.
+    std::unordered_map<std::uint32_t, ModelId> boxOfCount;
     for (std::uint32_t i = 0; i < n; ++i) {
         const StreamedLeaf& l = s->model.leaves[i];
-        auto id = engine.addBoundsModel(l.box, l.triangleCount);
-        if (!id) return id.error();
-        auto object = engine.addObject(*id, Transform{}, true);
+        auto found = boxOfCount.find(l.triangleCount);
+        if (found == boxOfCount.end()) {
+            auto id = engine.addBoundsModel(Aabb::fromMinMax(glm::vec3(0.0f), glm::vec3(1.0f)), l.triangleCount, false);
+            if (!id) return id.error();
+            found = boxOfCount.emplace(l.triangleCount, *id).first;
+        }
+        // Grown by a relative 1e-6 (a few float ulps at these magnitudes) so min + scale
+        // rounding can never pull a face inside the leaf; a flat leaf gets that thickness.
+        const glm::vec3 extent = l.box.max - l.box.min;
+        const float pad = 1e-6f * (glm::length(l.box.min) + glm::length(l.box.max) + glm::length(extent)) + 1e-30f;
+        Transform t;
+        t.translation = l.box.min - glm::vec3(pad);
+        t.scale = extent + glm::vec3(2.0f * pad);
+        auto object = engine.addObject(found->second, t, true);
         if (!object) return object.error();
         if (s->leafOfSlot.size() <= object->index) s->leafOfSlot.resize(object->index + 1, kInvalidIndex);
         s->leafOfSlot[object->index] = i;
@@ -285,11 +315,18 @@ std::optional<std::uint32_t> StreamedObjects::leafOf(ObjectHandle object) const 
     return leaf;
 }
 
+std::optional<std::uint32_t> StreamedObjects::leafOfSlot(std::uint32_t slot) const {
+    if (slot >= s_->leafOfSlot.size() || s_->leafOfSlot[slot] == kInvalidIndex) return std::nullopt;
+    return s_->leafOfSlot[slot];
+}
+
 Status StreamedObjects::readLeaf(std::uint32_t leaf, Mesh& out) const {
-    auto file = GeometryFile::open(s_->model);
-    if (!file) return file.error();
-    std::vector<unsigned char> scratch;
-    return file->read(leaf, out, scratch);
+    if (!s_->truthFile) {
+        auto file = GeometryFile::open(s_->model);
+        if (!file) return file.error();
+        s_->truthFile.emplace(file.take());
+    }
+    return s_->truthFile->read(leaf, out, s_->truthScratch);
 }
 
 const LeafCacheStats StreamedObjects::cacheStats() const { return s_->cache->stats(); }

@@ -233,7 +233,8 @@ void QueryScheduler::drawNode(Frame& f, NodeRef ref, bool untested) {
     f.stats.drawMs += msSince(t0);
     ++f.stats.partsDrawn;
     if (!clustered) {
-        f.stats.trianglesDrawn += n.indexCount / 3;
+        // A bounds model stands for its object: count what its draw costs, not the box.
+        f.stats.trianglesDrawn += model.drawTriangles > 0 ? model.drawTriangles : n.indexCount / 3;
     } else {
         for (const IndexRange& r : clusterRanges_) f.stats.trianglesDrawn += r.indexCount / 3;
     }

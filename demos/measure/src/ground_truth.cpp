@@ -84,10 +84,12 @@ Expected<std::unique_ptr<GroundTruth>> GroundTruth::create(GlContext& context) {
 }
 
 GroundTruth::~GroundTruth() {
-    for (GpuModel& m : models_) {
-        glDeleteVertexArrays(1, &m.vao);
-        glDeleteBuffers(1, &m.vbo);
-        glDeleteBuffers(1, &m.ibo);
+    for (std::vector<GpuModel>* list : {&models_, &substitutes_}) {
+        for (GpuModel& m : *list) {
+            glDeleteVertexArrays(1, &m.vao);
+            glDeleteBuffers(1, &m.vbo);
+            glDeleteBuffers(1, &m.ibo);
+        }
     }
     if (fbo_) glDeleteFramebuffers(1, &fbo_);
     if (colour_) glDeleteTextures(1, &colour_);
@@ -95,26 +97,46 @@ GroundTruth::~GroundTruth() {
     if (program_) glDeleteProgram(program_);
 }
 
-void GroundTruth::uploadModels(const SceneObjects& objects) {
-    for (ModelId id = static_cast<ModelId>(models_.size()); id < objects.modelCount(); ++id) {
-        const Mesh& mesh = objects.model(id).mesh;
-        GpuModel g;
-        const auto vbytes = static_cast<GLsizeiptr>(mesh.positions.size() * sizeof(glm::vec3));
-        const auto ibytes = static_cast<GLsizeiptr>(mesh.indices.size() * sizeof(std::uint32_t));
-        // Storage must be non-zero sized; an empty mesh still gets valid (1-byte) buffers.
-        glCreateBuffers(1, &g.vbo);
-        glNamedBufferStorage(g.vbo, vbytes ? vbytes : 1, vbytes ? mesh.positions.data() : nullptr, 0);
-        glCreateBuffers(1, &g.ibo);
-        glNamedBufferStorage(g.ibo, ibytes ? ibytes : 1, ibytes ? mesh.indices.data() : nullptr, 0);
-        glCreateVertexArrays(1, &g.vao);
-        glVertexArrayVertexBuffer(g.vao, 0, g.vbo, 0, sizeof(glm::vec3));
-        glVertexArrayElementBuffer(g.vao, g.ibo);
-        glEnableVertexArrayAttrib(g.vao, 0);
-        glVertexArrayAttribFormat(g.vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
-        glVertexArrayAttribBinding(g.vao, 0, 0);
-        g.cullBack = objects.model(id).faces == FaceMode::CullBack;
-        models_.push_back(g);
+void GroundTruth::upload(const Mesh& mesh, GpuModel& g) {
+    const auto vbytes = static_cast<GLsizeiptr>(mesh.positions.size() * sizeof(glm::vec3));
+    const auto ibytes = static_cast<GLsizeiptr>(mesh.indices.size() * sizeof(std::uint32_t));
+    // Storage must be non-zero sized; an empty mesh still gets valid (1-byte) buffers.
+    glCreateBuffers(1, &g.vbo);
+    glNamedBufferStorage(g.vbo, vbytes ? vbytes : 1, vbytes ? mesh.positions.data() : nullptr, 0);
+    glCreateBuffers(1, &g.ibo);
+    glNamedBufferStorage(g.ibo, ibytes ? ibytes : 1, ibytes ? mesh.indices.data() : nullptr, 0);
+    glCreateVertexArrays(1, &g.vao);
+    glVertexArrayVertexBuffer(g.vao, 0, g.vbo, 0, sizeof(glm::vec3));
+    glVertexArrayElementBuffer(g.vao, g.ibo);
+    glEnableVertexArrayAttrib(g.vao, 0);
+    glVertexArrayAttribFormat(g.vao, 0, 3, GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribBinding(g.vao, 0, 0);
+}
+
+const GroundTruth::GpuModel& GroundTruth::gpuFor(const SceneObjects& objects, std::uint32_t object) {
+    if (substitute_) {
+        if (substituteTried_.size() <= object) {
+            substituteTried_.resize(object + 1, 0);
+            substitutes_.resize(object + 1);
+        }
+        if (!substituteTried_[object]) {
+            substituteTried_[object] = 1;
+            Mesh mesh;
+            if (substitute_(object, mesh)) {
+                upload(mesh, substitutes_[object]);
+                substitutes_[object].wholeCount = static_cast<std::uint32_t>(mesh.indices.size());
+            }
+        }
+        if (substitutes_[object].vao) return substitutes_[object];
     }
+    const ModelId id = objects.modelOf(object);
+    if (models_.size() < objects.modelCount()) models_.resize(objects.modelCount());
+    GpuModel& g = models_[id];
+    if (!g.vao) {
+        upload(objects.model(id).mesh, g);
+        g.cullBack = objects.model(id).faces == FaceMode::CullBack;
+    }
+    return g;
 }
 
 VisibleSet GroundTruth::compute(const Engine& engine, const Camera& camera) {
@@ -123,7 +145,6 @@ VisibleSet GroundTruth::compute(const Engine& engine, const Camera& camera) {
 
 VisibleSet GroundTruth::compute(const SceneObjects& objects, const Camera& camera) {
     const auto t0 = std::chrono::steady_clock::now();
-    uploadModels(objects);
     const glm::ivec2 size = context_.size();
     if (size.x != width_ || size.y != height_ || !fbo_) {
         if (fbo_) glDeleteFramebuffers(1, &fbo_);
@@ -166,13 +187,16 @@ VisibleSet GroundTruth::compute(const SceneObjects& objects, const Camera& camer
         const ModelId model = objects.modelOf(ref.object);
         const LocalBspNode& n = objects.model(model).nodes[ref.node];
         if (n.indexCount == 0) continue;
-        const glm::mat4& toWorld = objects.matrix(ref.object);
-        detail::setFaceCulling(cullEnabled, frontCcw, models_[model].cullBack, glm::mat3(toWorld));
+        const GpuModel& gm = gpuFor(objects, ref.object);
+        static const glm::mat4 identity(1.0f);
+        const glm::mat4& toWorld = gm.wholeCount ? identity : objects.matrix(ref.object);
+        detail::setFaceCulling(cullEnabled, frontCcw, gm.cullBack, glm::mat3(toWorld));
         glUniform1ui(locId_, static_cast<GLuint>(i + 1));
         glUniformMatrix4fv(locModel_, 1, GL_FALSE, glm::value_ptr(camera.relativeModel(toWorld)));
-        glBindVertexArray(models_[model].vao);
-        glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(n.indexCount), GL_UNSIGNED_INT,
-                       reinterpret_cast<const void*>(static_cast<std::uintptr_t>(n.firstIndex) * sizeof(std::uint32_t)));
+        glBindVertexArray(gm.vao);
+        const std::uint32_t first = gm.wholeCount ? 0 : n.firstIndex, count = gm.wholeCount ? gm.wholeCount : n.indexCount;
+        glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(count), GL_UNSIGNED_INT,
+                       reinterpret_cast<const void*>(static_cast<std::uintptr_t>(first) * sizeof(std::uint32_t)));
     }
     glBindVertexArray(0);
     detail::resetFaceCulling(cullEnabled, frontCcw);

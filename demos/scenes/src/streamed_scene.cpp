@@ -83,6 +83,14 @@ public:
         return std::optional<StreamingFrameStats>(*s);
     }
 
+    std::function<bool(std::uint32_t, Mesh&)> truthGeometry() override {
+        return [this](std::uint32_t slot, Mesh& out) {
+            const auto leaf = objects_->leafOfSlot(slot);
+            // A leaf that does not read is drawn as its box: the frame's own draw reports it.
+            return leaf && objects_->readLeaf(*leaf, out).ok();
+        };
+    }
+
     Camera camera(std::uint64_t frame, float aspect) const override {
         return camera_ ? camera_->camera(frame, aspect) : staticModelCamera(bounds_, false, frame, aspect);
     }

@@ -99,7 +99,10 @@ public:
     /// is visible (buildBoundsModel: `triangles` is what a draw of it costs, for the cost
     /// model). The draw callback receives the box's index range for it; with the part
     /// renderer the box itself is drawn. Errors: bad bounds or 0 triangles, as addModel.
-    Expected<ModelId> addBoundsModel(const Aabb& bounds, std::uint32_t triangles);
+    /// `uploadBox` false: the part renderer never gets the box (tens of thousands of streamed
+    /// leaves would each cost GL buffers for nothing); only the draw callback draws it, and
+    /// without one its parts are counted drawn but nothing is drawn.
+    Expected<ModelId> addBoundsModel(const Aabb& bounds, std::uint32_t triangles, bool uploadBox = true);
     /// Adds an instance of a model (see SceneObjects::addObject: a static object never moves
     /// and costs nothing per frame).
     Expected<ObjectHandle> addObject(ModelId model, const Transform& transform, bool isStatic = false);
@@ -179,7 +182,9 @@ public:
         return *renderer_;
     }
     bool hasRenderer() const { return renderer_ != nullptr; }
-    /// The part renderer's mesh of `model` (its split mesh, uploaded by addModel).
+    /// The part renderer's mesh of `model` (its split mesh, uploaded by addModel), or kNoMesh.
+    /// meshOf a bounds model added without its box (addBoundsModel's uploadBox false).
+    static constexpr MeshId kNoMesh = 0xffffffffu;
     MeshId meshOf(ModelId model) const {
         assert(renderer_ && model < meshOfModel_.size());
         return meshOfModel_[model];
@@ -195,6 +200,7 @@ public:
 
 private:
     Engine(GlContext& context, const EngineOptions& options);
+    Expected<ModelId> addModel(LocalBsp bsp, bool upload);
     struct Sink;
     /// What a frame drew, with a per-slot stamp so membership is O(1).
     struct VisibleLists {

@@ -1,8 +1,9 @@
 // A streamed model (dyncull subdivide --memory-mb: a node file and a geometry file) as
 // objects of an Engine whose geometry is read and uploaded only when a leaf is drawn, under
 // two budgets: leaves in main memory (a LeafCache with read-ahead) and leaves in GL buffers
-// (least recently drawn released first). Each leaf is one static object whose model is its
-// box (Engine::addBoundsModel), so culling and queries never need the geometry.
+// (least recently drawn released first). Each leaf is one static object whose model is a
+// unit box (Engine::addBoundsModel, shared by the leaves of one triangle count) scaled and
+// placed on the leaf's box, so culling and queries never need the geometry.
 // Paper: Out-of-core interactive display of large meshes using an oriented bounding
 // box-based hardware depth query, section 5 (runtime memory management).
 #pragma once
@@ -86,7 +87,9 @@ public:
     const StreamedModel& model() const;
     /// The leaf an object of this set shows, if it is one.
     std::optional<std::uint32_t> leafOf(ObjectHandle object) const;
-    /// Reads a leaf straight from the file, outside both budgets (ground truth).
+    /// The leaf the object in slot `slot` shows, if it is one of this set's.
+    std::optional<std::uint32_t> leafOfSlot(std::uint32_t slot) const;
+    /// Reads a leaf straight from the file, outside both budgets and counters (ground truth).
     Status readLeaf(std::uint32_t leaf, Mesh& out) const;
     /// Totals since creation.
     const LeafCacheStats cacheStats() const;

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <vector>
@@ -54,6 +55,13 @@ public:
     VisibleSet compute(const Engine& engine, const Camera& camera);
     VisibleSet compute(const SceneObjects& objects, const Camera& camera);
 
+    /// Geometry drawn for an object (by slot) instead of its model's mesh: world space,
+    /// drawn whole and two-sided with no object transform. For streamed leaves, whose
+    /// models are boxes standing for them (StreamedObjects). Called once per object, when
+    /// it is first in the frustum; false keeps the model's mesh.
+    using MeshSubstitute = std::function<bool(std::uint32_t objectSlot, Mesh&)>;
+    void setMeshSubstitute(MeshSubstitute substitute) { substitute_ = std::move(substitute); }
+
     /// Ids of the last compute, top-down rows, width x height: 0 = background, else
     /// 1 + index into lastParts().
     const std::vector<std::uint32_t>& idImage() const { return ids_; }
@@ -64,7 +72,6 @@ public:
 
 private:
     explicit GroundTruth(GlContext& context) : context_(context) {}
-    void uploadModels(const SceneObjects& objects);
     /// Window-depth interval (reversed Z; with rounding slack) that every correct fragment
     /// of leaf `ref` lies in; [-1, 2] (no constraint) if its box reaches the near plane.
     /// `viewProj`: camera.viewProjectionRelativeDouble().
@@ -74,8 +81,17 @@ private:
     struct GpuModel {
         std::uint32_t vao = 0, vbo = 0, ibo = 0;
         bool cullBack = false;  // the model's FaceMode, as the renderer draws it
+        std::uint32_t wholeCount = 0;  // > 0: a substitute mesh, drawn whole and untransformed
     };
+    std::vector<GpuModel> substitutes_;            // by object slot
+    std::vector<std::uint8_t> substituteTried_;    // by object slot
+    /// Uploads `mesh` into `g` (positions and indices).
+    static void upload(const Mesh& mesh, GpuModel& g);
+    /// The GPU copy to draw for `object`: its substitute, else its model's (uploaded on first use).
+    const GpuModel& gpuFor(const SceneObjects& objects, std::uint32_t object);
+
     GlContext& context_;
+    MeshSubstitute substitute_;
     std::uint32_t fbo_ = 0, colour_ = 0, depth_ = 0, program_ = 0;
     int locViewProj_ = -1, locModel_ = -1, locId_ = -1;
     int width_ = 0, height_ = 0;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -40,6 +41,11 @@ public:
     /// After each frame is rendered (every mode and view of it): a streaming scene's
     /// counters for the frame, nothing for others. Error: a corrupt leaf met while drawing.
     virtual Expected<std::optional<StreamingFrameStats>> endFrame() { return std::optional<StreamingFrameStats>{}; }
+    /// For ground truth: the world-space geometry an object (by slot) really has when its
+    /// Engine model is only a box standing for it (streamed leaves); empty for scenes whose
+    /// models are their geometry. The function fills the mesh and returns true for such
+    /// an object, false for others.
+    virtual std::function<bool(std::uint32_t objectSlot, Mesh&)> truthGeometry() { return {}; }
     /// Set-up time (loading, subdivision, local BSP builds), ms, filled by populate.
     double setupMs() const { return setupMs_; }
 
