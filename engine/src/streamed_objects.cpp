@@ -306,6 +306,8 @@ Expected<StreamingFrameStats> StreamedObjects::endFrame() {
     return f;
 }
 
+void StreamedObjects::setLate(StreamLate late) { s_->options.late = late; }
+
 const StreamedModel& StreamedObjects::model() const { return s_->model; }
 
 std::optional<std::uint32_t> StreamedObjects::leafOf(ObjectHandle object) const {

@@ -46,7 +46,7 @@ public:
         StreamingOptions opts;
         opts.memoryBytes = so.inCore ? 0 : std::size_t{so.memoryMb} << 20;
         opts.gpuBytes = so.inCore ? 0 : std::size_t{so.gpuMemoryMb} << 20;
-        opts.late = *late;
+        opts.late = late_ = *late;
         auto objects = StreamedObjects::create(engine, path_, opts);
         if (!objects) return objects.error();
         objects_ = objects.take();
@@ -77,6 +77,7 @@ public:
 
     Status update(Engine&, std::uint64_t) override { return {}; }
     void beginFrame(const Camera& camera) override { objects_->beginFrame(camera); }
+    void setReferencePass(bool on) override { objects_->setLate(on ? StreamLate::Wait : late_); }
     Expected<std::optional<StreamingFrameStats>> endFrame() override {
         auto s = objects_->endFrame();
         if (!s) return s.error();
@@ -100,6 +101,7 @@ private:
     std::string path_, name_, description_;
     SceneOptions options_;
     std::unique_ptr<StreamedObjects> objects_;
+    StreamLate late_ = StreamLate::Wait;
     std::unique_ptr<DemoScene> camera_;
     Aabb bounds_;
 };

@@ -84,6 +84,9 @@ public:
     /// first error a draw met (a corrupt leaf, naming the file and the leaf).
     Expected<StreamingFrameStats> endFrame();
 
+    /// Changes what a frame does with late leaves from now on (a measurement's reference
+    /// pass waits for every leaf while the measured modes skip).
+    void setLate(StreamLate late);
     const StreamedModel& model() const;
     /// The leaf an object of this set shows, if it is one.
     std::optional<std::uint32_t> leafOf(ObjectHandle object) const;

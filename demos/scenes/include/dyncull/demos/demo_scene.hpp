@@ -41,6 +41,9 @@ public:
     /// After each frame is rendered (every mode and view of it): a streaming scene's
     /// counters for the frame, nothing for others. Error: a corrupt leaf met while drawing.
     virtual Expected<std::optional<StreamingFrameStats>> endFrame() { return std::optional<StreamingFrameStats>{}; }
+    /// On while `bench` renders its reference image (vfc): a scene that may leave work
+    /// out (streamed leaves not yet read, StreamLate::Draw or Skip) does it all then.
+    virtual void setReferencePass(bool /*on*/) {}
     /// For ground truth: the world-space geometry an object (by slot) really has when its
     /// Engine model is only a box standing for it (streamed leaves); empty for scenes whose
     /// models are their geometry. The function fills the mesh and returns true for such
