@@ -23,12 +23,16 @@ struct LeafCache::State {
     struct Entry {
         std::unique_ptr<Mesh> mesh;  // null: not resident
         std::uint32_t pins = 0;
-        std::uint64_t used = 0;      // clock of the last acquire or prefetch
+        std::uint64_t used = 0;      // clock of the last acquire
         bool loading = false;        // being read by some thread
     };
     std::vector<Entry> entries;
     std::vector<std::uint32_t> wanted;  // the read-ahead list
-    std::vector<std::uint8_t> protect;  // per leaf: in the read-ahead list before the current position
+    /// Per leaf: its position in the read-ahead list, kNotWanted if not in it. Eviction
+    /// takes unwanted leaves first (least recently used first), then the furthest down.
+    std::vector<std::uint32_t> rank;
+    static constexpr std::uint32_t kNotWanted = 0xffffffffu;
+    std::vector<std::uint32_t> residentList;  // leaves with a mesh, in no order
     std::size_t next = 0;               // position in `wanted`
     std::uint64_t clock = 0;
     bool busy = false, stop = false;
@@ -42,22 +46,32 @@ struct LeafCache::State {
         const StreamedLeaf& l = leaves[leaf];
         return std::size_t{l.vertexCount} * 24 + std::size_t{l.triangleCount} * 12;
     }
-    /// Evicts least-recently-used leaves that are neither pinned nor loading until `bytes`
-    /// more fit; leaves earlier in the read-ahead list go only for a leaf needed now
-    /// (`demand`). Lock held. false if they cannot be made to fit. A linear scan: leaves
-    /// number tens of thousands, and an eviction reads a chunk, which costs far more.
-    bool makeRoom(std::size_t bytes, bool demand) {
+    /// Evicts unpinned leaves until `bytes` more fit: first those not in the read-ahead
+    /// list (least recently used first), then those furthest down it; read-ahead of the leaf
+    /// at position `keepUpTo` never displaces one at or before it (a leaf needed now,
+    /// `keepUpTo` < 0, may displace any). Lock held. false if they cannot be
+    /// made to fit. A scan of the resident leaves: an eviction reads a chunk, which costs
+    /// far more.
+    bool makeRoom(std::size_t bytes, std::int64_t keepUpTo) {
         while (stats.residentBytes + bytes > budget) {
             std::size_t victim = SIZE_MAX;
-            for (int pass = 0; pass < (demand ? 2 : 1) && victim == SIZE_MAX; ++pass)
-                for (std::size_t i = 0; i < entries.size(); ++i) {
-                    const Entry& e = entries[i];
-                    if (!e.mesh || e.pins || (pass == 0 && protect[i])) continue;
-                    if (victim == SIZE_MAX || e.used < entries[victim].used) victim = i;
+            for (std::size_t k = 0; k < residentList.size(); ++k) {
+                const std::uint32_t i = residentList[k];
+                const Entry& e = entries[i];
+                if (e.pins || (rank[i] != kNotWanted && std::int64_t{rank[i]} <= keepUpTo)) continue;
+                if (victim == SIZE_MAX) {
+                    victim = k;
+                    continue;
                 }
+                const std::uint32_t v = residentList[victim];
+                if (rank[i] > rank[v] || (rank[i] == rank[v] && e.used < entries[v].used)) victim = k;
+            }
             if (victim == SIZE_MAX) return false;
-            stats.residentBytes -= leafBytes(*entries[victim].mesh);
-            entries[victim].mesh.reset();
+            const std::uint32_t v = residentList[victim];
+            stats.residentBytes -= leafBytes(*entries[v].mesh);
+            entries[v].mesh.reset();
+            residentList[victim] = residentList.back();
+            residentList.pop_back();
             ++stats.evictions;
         }
         return true;
@@ -66,7 +80,7 @@ struct LeafCache::State {
     /// this), then publishes it if room allows. Lock held on entry and exit.
     Status load(std::unique_lock<std::mutex>& lock, std::uint32_t leaf, bool prefetching) {
         const std::size_t bytes = bytesOf(leaf);
-        if (!makeRoom(bytes, !prefetching)) return Error{"leaf cache: the budget is full of leaves in use", ErrorCode::OutOfMemory};
+        if (!makeRoom(bytes, prefetching ? std::int64_t{rank[leaf]} : -1)) return Error{"leaf cache: the budget is full of leaves in use", ErrorCode::OutOfMemory};
         // Reserve the bytes before reading, so two threads cannot both count on them.
         stats.residentBytes += bytes;
         entries[leaf].loading = true;
@@ -82,6 +96,7 @@ struct LeafCache::State {
             return st;
         }
         entries[leaf].mesh = std::move(mesh);
+        residentList.push_back(leaf);
         ++stats.loads;
         if (prefetching) ++stats.prefetchLoads;
         stats.bytesRead += leaves[leaf].chunkBytes;
@@ -95,10 +110,8 @@ struct LeafCache::State {
             if (stop) return;
             busy = true;
             const std::uint32_t leaf = wanted[next];
-            protect[leaf] = 1;
             ++next;
             Entry& e = entries[leaf];
-            e.used = ++clock;
             if (!e.mesh && !e.loading) {
                 // Full of wanted leaves: nothing further down the list may displace them. (A
                 // bad chunk is skipped here and reported when the leaf is acquired.)
@@ -137,17 +150,20 @@ Expected<std::unique_ptr<LeafCache>> LeafCache::create(const StreamedModel& mode
                              std::to_string(budgetBytes >> 20) + " MB",
                          ErrorCode::BadArgument};
     s->entries.resize(s->leaves.size());
-    s->protect.assign(s->leaves.size(), 0);
+    s->rank.assign(s->leaves.size(), State::kNotWanted);
     return std::unique_ptr<LeafCache>(new LeafCache(std::move(s)));
 }
 
 void LeafCache::prefetch(std::span<const std::uint32_t> leaves) {
     {
         std::lock_guard lock(s_->mutex);
-        std::fill(s_->protect.begin(), s_->protect.end(), 0);
+        for (std::uint32_t l : s_->wanted) s_->rank[l] = State::kNotWanted;
         s_->wanted.clear();
         for (std::uint32_t l : leaves)
-            if (l < s_->entries.size()) s_->wanted.push_back(l);
+            if (l < s_->entries.size() && s_->rank[l] == State::kNotWanted) {
+                s_->rank[l] = static_cast<std::uint32_t>(s_->wanted.size());
+                s_->wanted.push_back(l);
+            }
         s_->next = 0;
     }
     s_->wake.notify_all();

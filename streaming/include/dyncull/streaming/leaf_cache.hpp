@@ -43,8 +43,9 @@ public:
     LeafCache& operator=(const LeafCache&) = delete;
 
     /// Replaces the read-ahead list: the loader thread reads these leaves in order (most
-    /// wanted first) while the budget allows, evicting only leaves that are neither pinned
-    /// nor earlier in the list; it stops at the first leaf that does not fit. Returns at once.
+    /// wanted first) while the budget allows, evicting leaves not in the list (least
+    /// recently used first), then those further down it, never pinned ones; it stops at the
+    /// first leaf that does not fit. A leaf needed now evicts in the same order. Returns at once.
     void prefetch(std::span<const std::uint32_t> leaves);
     /// The leaf's geometry, pinned; read at once on this thread when not resident (counted
     /// as a miss and stall time). Errors: the leaf's chunk is corrupt (naming the file and
