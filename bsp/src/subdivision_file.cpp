@@ -17,13 +17,60 @@ namespace dyncull {
 namespace {
 
 constexpr char kMagic[8] = {'D', 'Y', 'N', 'C', 'S', 'U', 'B', '\0'};
-constexpr std::size_t kNodeBytes = 6 * 4 + 5 * 4;
-
 Error bad(const std::filesystem::path& path, const std::string& why) {
     return Error{"subdivision file " + path.string() + ": " + why};
 }
 
 }  // namespace
+
+void writeSubdivisionParams(BinaryWriter& w, const SubdivisionParams& p) {
+    w.put(static_cast<std::uint8_t>(p.method));
+    w.put(p.maxLeafTriangles);
+    w.put(p.maxDepth);
+    w.put(p.exactBelow);
+    w.put(p.sahBins);
+    w.put(p.planeMove);
+    w.put(p.pullUpWidths);
+    w.put(p.collapseTo);
+}
+
+std::string readSubdivisionParams(BinaryReader& r, SubdivisionParams& p) {
+    const auto method = r.get<std::uint8_t>();
+    if (method > static_cast<std::uint8_t>(SubdivisionMethod::Grid)) return "unknown method " + std::to_string(method);
+    p.method = static_cast<SubdivisionMethod>(method);
+    p.maxLeafTriangles = r.get<std::uint32_t>();
+    p.maxDepth = r.get<std::uint32_t>();
+    p.exactBelow = r.get<std::uint32_t>();
+    p.sahBins = r.get<std::uint32_t>();
+    p.planeMove = r.get<float>();
+    p.pullUpWidths = r.get<float>();
+    p.collapseTo = r.get<std::uint32_t>();
+    if (r.failed()) return "truncated parameters";
+    if (Status s = validateSubdivisionParams(p); !s) return s.message();
+    return {};
+}
+
+void writeSubdivisionNode(BinaryWriter& w, const SubdivisionNode& n) {
+    w.put(n.box.min);
+    w.put(n.box.max);
+    w.put(n.firstChild);
+    w.put(n.childCount);
+    w.put(n.firstTriangle);
+    w.put(n.triangleCount);
+    w.put(n.depth);
+}
+
+SubdivisionNode readSubdivisionNode(BinaryReader& r) {
+    SubdivisionNode n;
+    n.box.min = r.get<glm::vec3>();
+    n.box.max = r.get<glm::vec3>();
+    n.firstChild = r.get<std::uint32_t>();
+    n.childCount = r.get<std::uint32_t>();
+    n.firstTriangle = r.get<std::uint32_t>();
+    n.triangleCount = r.get<std::uint32_t>();
+    n.depth = r.get<std::uint32_t>();
+    return n;
+}
 
 Status writeSubdivisionFile(const std::filesystem::path& path, const SubdividedModel& m) {
     if (!m.subdivision.triangles.empty())
@@ -38,29 +85,13 @@ Status writeSubdivisionFile(const std::filesystem::path& path, const SubdividedM
         f.write(zeros, sizeof zeros);
         BinaryWriter w(f);
         w.str<std::uint32_t>(m.source);
-        const SubdivisionParams& p = m.params;
-        w.put(static_cast<std::uint8_t>(p.method));
-        w.put(p.maxLeafTriangles);
-        w.put(p.maxDepth);
-        w.put(p.exactBelow);
-        w.put(p.sahBins);
-        w.put(p.planeMove);
-        w.put(p.pullUpWidths);
-        w.put(p.collapseTo);
+        writeSubdivisionParams(w, m.params);
         w.str<std::uint32_t>(m.mesh.name);
         w.array<std::uint64_t>(m.mesh.positions);
         w.array<std::uint64_t>(m.mesh.normals);
         w.array<std::uint64_t>(m.mesh.indices);
         w.put(static_cast<std::uint64_t>(m.subdivision.nodes.size()));
-        for (const SubdivisionNode& n : m.subdivision.nodes) {
-            w.put(n.box.min);
-            w.put(n.box.max);
-            w.put(n.firstChild);
-            w.put(n.childCount);
-            w.put(n.firstTriangle);
-            w.put(n.triangleCount);
-            w.put(n.depth);
-        }
+        for (const SubdivisionNode& n : m.subdivision.nodes) writeSubdivisionNode(w, n);
         w.put(m.subdivision.stats.buildMs);
         w.put(static_cast<std::uint64_t>(m.subdivision.stats.workBytes));
         hash = w.hash();
@@ -121,36 +152,17 @@ Expected<SubdividedModel> readSubdivisionFile(const std::filesystem::path& path)
     m.sourceHash = sourceHash;
     if (!r.str<std::uint32_t>(m.source, 4096)) return bad(path, "truncated source name");
     SubdivisionParams& p = m.params;
-    const auto method = r.get<std::uint8_t>();
-    if (method > static_cast<std::uint8_t>(SubdivisionMethod::Grid)) return bad(path, "unknown method " + std::to_string(method));
-    p.method = static_cast<SubdivisionMethod>(method);
-    p.maxLeafTriangles = r.get<std::uint32_t>();
-    p.maxDepth = r.get<std::uint32_t>();
-    p.exactBelow = r.get<std::uint32_t>();
-    p.sahBins = r.get<std::uint32_t>();
-    p.planeMove = r.get<float>();
-    p.pullUpWidths = r.get<float>();
-    p.collapseTo = r.get<std::uint32_t>();
-    if (r.failed()) return bad(path, "truncated parameters");
-    if (Status s = validateSubdivisionParams(p); !s) return bad(path, s.message());
+    if (std::string why = readSubdivisionParams(r, p); !why.empty()) return bad(path, why);
     if (!r.str<std::uint32_t>(m.mesh.name, 4096) || !r.array<std::uint64_t>(m.mesh.positions) || !r.array<std::uint64_t>(m.mesh.normals) || !r.array<std::uint64_t>(m.mesh.indices))
         return bad(path, "truncated mesh");
     if (std::string why = validateMesh(m.mesh); !why.empty()) return bad(path, why);
     if (std::string why = validateNormals(m.mesh); !why.empty()) return bad(path, why);
     const auto nodes = r.get<std::uint64_t>();
-    if (r.failed() || nodes == 0 || nodes > r.left() / kNodeBytes) return bad(path, "node count out of range");
+    if (r.failed() || nodes == 0 || nodes > r.left() / kSubdivisionNodeBytes) return bad(path, "node count out of range");
     Subdivision& sub = m.subdivision;
     sub.method = p.method;
     sub.nodes.resize(static_cast<std::size_t>(nodes));
-    for (SubdivisionNode& n : sub.nodes) {
-        n.box.min = r.get<glm::vec3>();
-        n.box.max = r.get<glm::vec3>();
-        n.firstChild = r.get<std::uint32_t>();
-        n.childCount = r.get<std::uint32_t>();
-        n.firstTriangle = r.get<std::uint32_t>();
-        n.triangleCount = r.get<std::uint32_t>();
-        n.depth = r.get<std::uint32_t>();
-    }
+    for (SubdivisionNode& n : sub.nodes) n = readSubdivisionNode(r);
     sub.stats.buildMs = r.get<double>();
     sub.stats.workBytes = static_cast<std::size_t>(r.get<std::uint64_t>());
     if (r.failed()) return bad(path, "truncated tree");

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <fstream>
 
+#include "dyncull/bsp/subdivision_file.hpp"
 #include "dyncull/objects/binary_file.hpp"
 #include "dyncull/objects/checksum.hpp"
 #include "dyncull/objects/checked_write.hpp"
@@ -21,7 +22,6 @@ namespace dyncull {
 namespace {
 
 constexpr char kNodeMagic[8] = {'D', 'Y', 'N', 'C', 'N', 'O', 'D', '\0'};
-constexpr std::size_t kNodeBytes = 44;
 constexpr std::size_t kLeafBytes = 4 * 4 + 2 * 8 + 2 * 12 + (12 + 36 + 12 + 4);
 
 Error badNodes(const std::filesystem::path& path, const std::string& why) {
@@ -211,26 +211,10 @@ Status StreamedModelWriter::finish(StreamedModel& m) {
         BinaryWriter w(f);
         w.str<std::uint32_t>(m.source);
         w.put(m.sourceHash);
-        const SubdivisionParams& p = m.params;
-        w.put(static_cast<std::uint8_t>(p.method));
-        w.put(p.maxLeafTriangles);
-        w.put(p.maxDepth);
-        w.put(p.exactBelow);
-        w.put(p.sahBins);
-        w.put(p.planeMove);
-        w.put(p.pullUpWidths);
-        w.put(p.collapseTo);
+        writeSubdivisionParams(w, m.params);
         w.put(m.geometryBytes);
         w.put(static_cast<std::uint32_t>(m.nodes.size()));
-        for (const SubdivisionNode& n : m.nodes) {
-            w.put(n.box.min);
-            w.put(n.box.max);
-            w.put(n.firstChild);
-            w.put(n.childCount);
-            w.put(n.firstTriangle);
-            w.put(n.triangleCount);
-            w.put(n.depth);
-        }
+        for (const SubdivisionNode& n : m.nodes) writeSubdivisionNode(w, n);
         w.put(static_cast<std::uint32_t>(m.leaves.size()));
         for (const StreamedLeaf& l : m.leaves) {
             w.put(l.node);
@@ -304,32 +288,12 @@ Expected<StreamedModel> readStreamedModel(const std::filesystem::path& path) {
     BinaryReader r(f, payload);
     if (!r.str<std::uint32_t>(m.source, 4096)) return badNodes(path, "truncated source name");
     m.sourceHash = r.get<std::uint64_t>();
-    SubdivisionParams& p = m.params;
-    const auto method = r.get<std::uint8_t>();
-    if (method > static_cast<std::uint8_t>(SubdivisionMethod::Grid)) return badNodes(path, "unknown method " + std::to_string(method));
-    p.method = static_cast<SubdivisionMethod>(method);
-    p.maxLeafTriangles = r.get<std::uint32_t>();
-    p.maxDepth = r.get<std::uint32_t>();
-    p.exactBelow = r.get<std::uint32_t>();
-    p.sahBins = r.get<std::uint32_t>();
-    p.planeMove = r.get<float>();
-    p.pullUpWidths = r.get<float>();
-    p.collapseTo = r.get<std::uint32_t>();
+    if (std::string why = readSubdivisionParams(r, m.params); !why.empty()) return badNodes(path, why);
     m.geometryBytes = r.get<std::uint64_t>();
-    if (r.failed()) return badNodes(path, "truncated parameters");
-    if (Status st = validateSubdivisionParams(p); !st) return badNodes(path, st.message());
     const auto nodes = r.get<std::uint32_t>();
-    if (r.failed() || nodes == 0 || nodes > r.left() / kNodeBytes) return badNodes(path, "node count out of range");
+    if (r.failed() || nodes == 0 || nodes > r.left() / kSubdivisionNodeBytes) return badNodes(path, "node count out of range");
     m.nodes.resize(nodes);
-    for (SubdivisionNode& n : m.nodes) {
-        n.box.min = r.get<glm::vec3>();
-        n.box.max = r.get<glm::vec3>();
-        n.firstChild = r.get<std::uint32_t>();
-        n.childCount = r.get<std::uint32_t>();
-        n.firstTriangle = r.get<std::uint32_t>();
-        n.triangleCount = r.get<std::uint32_t>();
-        n.depth = r.get<std::uint32_t>();
-    }
+    for (SubdivisionNode& n : m.nodes) n = readSubdivisionNode(r);
     const auto leaves = r.get<std::uint32_t>();
     if (r.failed() || leaves > r.left() / kLeafBytes) return badNodes(path, "leaf count out of range");
     m.leaves.resize(leaves);

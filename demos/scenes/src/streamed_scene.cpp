@@ -17,18 +17,6 @@
 namespace dyncull {
 namespace {
 
-std::unique_ptr<DemoScene> builtinCamera(const std::string& source, const SceneOptions& o) {
-    if (source == "powerplant") return makePowerPlant(o.plant);
-    if (source == "city") return makeCity(o.city);
-    return nullptr;
-}
-
-std::uint64_t builtinHash(const std::string& source, const SceneOptions& o) {
-    if (source == "powerplant") return powerPlantParamsHash(o.plant);
-    if (source == "city") return cityParamsHash(o.city);
-    return 0;
-}
-
 class StreamedScene final : public DemoScene {
 public:
     StreamedScene(std::string path, const SceneOptions& options) : path_(std::move(path)), options_(options) {
@@ -55,7 +43,7 @@ public:
         if (so.cameraOf.empty() && builtinHash(m.source, options_) != m.sourceHash)
             return Error{path_ + ": made from '" + m.source + "' with other generator options; pass the --plant-*/--city-* "
                          "options it was made with"};
-        camera_ = builtinCamera(cameraSource, options_);
+        camera_ = builtinCameraScene(cameraSource, options_);
         if (!so.cameraOf.empty() && !camera_) return Error{"--camera-of: '" + so.cameraOf + "' is not powerplant or city"};
         bounds_ = m.nodes[0].box;
         char line[512];

@@ -23,19 +23,6 @@ Scene toScene(GeneratedScene&& g) {
     return s;
 }
 
-/// The built-in scene whose camera path a subdivided source flies, or null for files.
-std::unique_ptr<DemoScene> builtinCameraScene(const std::string& source, const SceneOptions& o) {
-    if (source == "powerplant") return makePowerPlant(o.plant);
-    if (source == "city") return makeCity(o.city);
-    return nullptr;
-}
-
-std::uint64_t builtinHash(const std::string& source, const SceneOptions& o) {
-    if (source == "powerplant") return powerPlantParamsHash(o.plant);
-    if (source == "city") return cityParamsHash(o.city);
-    return 0;
-}
-
 std::string stem(const std::string& source) {
     if (source == "powerplant" || source == "city") return source;
     const std::filesystem::path p(source);
@@ -120,6 +107,18 @@ private:
 };
 
 }  // namespace
+
+std::unique_ptr<DemoScene> builtinCameraScene(const std::string& source, const SceneOptions& o) {
+    if (source == "powerplant") return makePowerPlant(o.plant);
+    if (source == "city") return makeCity(o.city);
+    return nullptr;
+}
+
+std::uint64_t builtinHash(const std::string& source, const SceneOptions& o) {
+    if (source == "powerplant") return powerPlantParamsHash(o.plant);
+    if (source == "city") return cityParamsHash(o.city);
+    return 0;
+}
 
 Expected<StaticSoup> loadStaticSoup(const std::string& nameOrPath, const SceneOptions& options) {
     StaticSoup out;

@@ -17,6 +17,7 @@
 #include <string>
 
 #include "dyncull/bsp/subdivision.hpp"
+#include "dyncull/objects/binary_file.hpp"
 #include "dyncull/objects/error.hpp"
 #include "dyncull/objects/mesh.hpp"
 #include "dyncull/objects/surface_orientation.hpp"
@@ -42,6 +43,18 @@ struct SubdividedModel {
     /// (subdivideStaticScene); a model read from a file has none, and is analysed.
     std::optional<SurfaceReport> surface;
 };
+
+/// The subdivision parameters (threads excepted) and tree nodes as records of dyncull's
+/// binary files: the .dsub file here and a streamed model's node file (streaming/) share
+/// these, so both read and write them one way.
+void writeSubdivisionParams(BinaryWriter& w, const SubdivisionParams& p);
+/// Reads what writeSubdivisionParams wrote: "" or why not (truncated, unknown method,
+/// a parameter out of range).
+std::string readSubdivisionParams(BinaryReader& r, SubdivisionParams& p);
+inline constexpr std::size_t kSubdivisionNodeBytes = 44;  ///< a node record
+void writeSubdivisionNode(BinaryWriter& w, const SubdivisionNode& n);
+/// A node record, unchecked (the readers validate the whole tree); zeros after a failure.
+SubdivisionNode readSubdivisionNode(BinaryReader& r);
 
 /// Writes via a temporary file renamed into place (readers never see half a file).
 /// Errors name the path. `model.subdivision.triangles` must be empty (applyTriangleOrder).
