@@ -184,7 +184,7 @@ Expected<std::unique_ptr<StreamedObjects>> StreamedObjects::create(Engine& engin
     s->model = model.take();
     std::size_t total = 0, largest = 0;
     for (const StreamedLeaf& l : s->model.leaves) {
-        const std::size_t b = std::size_t{l.vertexCount} * 24 + std::size_t{l.triangleCount} * 12;
+        const std::size_t b = leafBytes(l);
         total += b;
         largest = std::max(largest, b);
     }

@@ -88,6 +88,11 @@ std::size_t leafBytes(const Mesh& leaf) {
     return (leaf.positions.size() + leaf.normals.size()) * sizeof(glm::vec3) + leaf.indices.size() * sizeof(std::uint32_t);
 }
 
+std::size_t leafBytes(const StreamedLeaf& leaf) {
+    // A position and a normal per vertex, three 32-bit indices per triangle, as read.
+    return std::size_t{leaf.vertexCount} * 2 * sizeof(glm::vec3) + std::size_t{leaf.triangleCount} * 3 * sizeof(std::uint32_t);
+}
+
 struct GeometryFile::State {
     std::filesystem::path path;
     std::vector<StreamedLeaf> leaves;

@@ -42,10 +42,7 @@ struct LeafCache::State {
     explicit State(GeometryFile f) : file(std::move(f)) {}
 
     /// Bytes a leaf will take once read: known from the node file without reading it.
-    std::size_t bytesOf(std::uint32_t leaf) const {
-        const StreamedLeaf& l = leaves[leaf];
-        return std::size_t{l.vertexCount} * 24 + std::size_t{l.triangleCount} * 12;
-    }
+    std::size_t bytesOf(std::uint32_t leaf) const { return leafBytes(leaves[leaf]); }
     /// Evicts unpinned leaves until `bytes` more fit: first those not in the read-ahead
     /// list (least recently used first), then those furthest down it; read-ahead of the leaf
     /// at position `keepUpTo` never displaces one at or before it (a leaf needed now,

@@ -28,8 +28,8 @@ constexpr std::size_t kIoBuffer = std::size_t{1} << 20;
 /// Histogram resolution of a streamed split's median search: the median is found to
 /// 1/1024 of the node's centroid extent, which balances the halves to well within a percent.
 constexpr int kBins = 1024;
-/// Memory of an in-memory subtree per triangle, measured on scanned and CAD meshes with
-/// room to spare: the records (48), vertex ids sorted for the mesh (12 + 4), the mesh
+/// Memory of an in-memory subtree per triangle, an estimate with room to spare (the
+/// preprocessing runs in docs/BENCHMARKS.md peak well under their budgets): the records (48), vertex ids sorted for the mesh (12 + 4), the mesh
 /// (indices 12, positions and normals 24 per vertex, up to 3 vertices per triangle), the
 /// subdivision's work arrays (SubdivisionStats::workBytes, about 60) and the leaf meshes
 /// with meshoptimizer's scratch (about the mesh again).
@@ -79,6 +79,7 @@ class ParseSink final : public MeshStreamSink {
 public:
     RecordWriter positions, normals, polygons;
     MeshStreamLayout layout;
+    Aabb box;  // of every vertex: bounds the centroids, the root histogram's range
     std::uint64_t vertices = 0, polygonCount = 0, corners = 0;
     bool normalsUsable = true;  // every source normal finite and non-zero
     const OutOfCoreProgress* progressFn = nullptr;
@@ -90,6 +91,7 @@ public:
     }
     Status vertex(const glm::vec3& p, const glm::vec3& n) override {
         ++vertices;
+        box.extend(p);
         if (Status s = positions.write(&p, sizeof p); !s) return s;
         if (normalsUsable) {
             const float len = glm::length(n);
@@ -173,6 +175,7 @@ Status Builder::parse(const MeshStreamSource& source) {
     stats.tempBytesWritten += sink.positions.written() + sink.normals.written() + sink.polygons.written();
     if (sink.vertices == 0 || sink.polygonCount == 0) return Error{"the model has no triangles", ErrorCode::BadFile};
     if (sink.vertices > 0xFFFFFFFFull) return Error{"more than 2^32 vertices", ErrorCode::BadFile};
+    vertexBox_ = sink.box;
     computeNormals_ = !sink.normalsUsable;
     stats.normalsFromSource = sink.normalsUsable;
     if (computeNormals_) {
@@ -199,15 +202,8 @@ Status Builder::triangulate() {
     Work root;
     root.file = newFile();
     root.histogram = std::make_unique<Histogram>();
-    // Centroids lie in the box of the vertices, known only after pass 1: that is the
-    // root histogram's range. (Unused vertices may widen it; the median search copes.)
-    {
-        RecordReader all;
-        if (Status s = all.open(positionsPath_, kIoBuffer); !s) return s;
-        glm::vec3 p;
-        while (all.read(&p, sizeof p)) vertexBox_.extend(p);
-        stats.tempBytesRead += all.bytesRead();
-    }
+    // Centroids lie in the box of the vertices, gathered in pass 1: that is the root
+    // histogram's range. (Unused vertices may widen it; the median search copes.)
     root.histogram->range = vertexBox_;
     RecordWriter out;
     if (Status s = out.open(root.file, kIoBuffer); !s) return s;

@@ -45,6 +45,9 @@ inline constexpr std::uint32_t kMaxLeafChunkBytes = 256u << 20;
 /// Main-memory bytes of a leaf's geometry as read (positions, normals, indices): what the
 /// streaming budgets count.
 std::size_t leafBytes(const Mesh& leaf);
+struct StreamedLeaf;
+/// The same, known from the node file before the leaf is read.
+std::size_t leafBytes(const StreamedLeaf& leaf);
 
 /// Where a leaf's geometry is, and the volumes the scheduler tests before loading it.
 struct StreamedLeaf {
