@@ -5,10 +5,18 @@
 // its own motion: crates circling behind and in front of a long wall. dyncull borrows the
 // context and calls back with the visible parts of each crate.
 //
-//   glfw_game [--frames N] [--screenshot FILE.png]     (N = 0: until the window closes)
+//   glfw_game [--frames N] [--screenshot FILE.png] [--check]     (N = 0: until the window closes)
+//
+// --check draws the last frame again without asking dyncull and compares: culling is
+// conservative, so the pictures must agree (the program fails if more than 0.01% of the
+// pixels differ). It then draws the same frame with dyncull's own part renderer (a second
+// engine on the same context): its shading is dyncull's, but its surfaces must be the
+// game's, so the depth buffers must agree (again at most 0.01% of the pixels apart).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -156,12 +164,15 @@ GLuint upload(const dyncull::LocalBsp& bsp, const std::vector<float>& uv) {
 int main(int argc, char** argv) {
     int frames = 0;
     std::string screenshot;
+    bool check = false;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         if (a == "--frames" && i + 1 < argc) frames = std::atoi(argv[++i]);
         else if (a == "--screenshot" && i + 1 < argc) screenshot = argv[++i];
-        else fail("usage: glfw_game [--frames N] [--screenshot FILE.png]");
+        else if (a == "--check") check = true;
+        else fail("usage: glfw_game [--frames N] [--screenshot FILE.png] [--check]");
     }
+    if (frames < 0 || (check && frames == 0)) fail("--frames must be positive (and given with --check)");
 
     // The game's window and context.
     if (!glfwInit()) fail("no display for a window");
@@ -223,8 +234,7 @@ int main(int argc, char** argv) {
     if (dyncull::Status s = engine.setCamera(camera); !s) fail(s.message());
     const glm::mat4 viewProj = camera.viewProjection();
     const std::vector<glm::vec3> tints = {{1.0f, 1.0f, 1.0f}, {0.7f, 0.7f, 0.75f}};
-    engine.setDrawCallback([&](dyncull::ObjectHandle, dyncull::ModelId model, std::uint32_t first, std::uint32_t count,
-                               const glm::mat4& objectToWorld) {
+    auto drawPart = [&](dyncull::ModelId model, std::uint32_t first, std::uint32_t count, const glm::mat4& objectToWorld) {
         glUseProgram(program);
         glBindTextureUnit(0, texture);
         glUniformMatrix4fv(locViewProj, 1, GL_FALSE, &viewProj[0][0]);
@@ -232,7 +242,38 @@ int main(int argc, char** argv) {
         glUniform3fv(locTint, 1, &tints[model][0]);
         glBindVertexArray(vaos[model]);
         glDrawElements(GL_TRIANGLES, GLsizei(count), GL_UNSIGNED_INT, reinterpret_cast<const void*>(std::uintptr_t{first} * 4));
-    });
+    };
+    engine.setDrawCallback([&](dyncull::ObjectHandle, dyncull::ModelId model, std::uint32_t first, std::uint32_t count,
+                               const glm::mat4& objectToWorld) { drawPart(model, first, count, objectToWorld); });
+
+    // Everything, whole, with the state dyncull's frame contract sets for its callback.
+    auto drawEverything = [&] {
+        glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_GREATER);
+        const dyncull::SceneObjects& objects = engine.objects();
+        for (std::uint32_t i = 0; i < objects.slotCount(); ++i)
+            if (objects.alive(i)) drawPart(objects.modelOf(i), 0, indexCounts[objects.modelOf(i)], objects.matrix(i));
+    };
+    auto clearFrame = [&] {
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+        glViewport(0, 0, kWidth, kHeight);
+        glClearColor(0.45f, 0.6f, 0.8f, 1.0f);
+        glClearDepth(0.0);  // reversed Z: 0 is the far plane
+        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    };
+    auto readFrame = [&] {
+        std::vector<unsigned char> rgba(std::size_t{kWidth} * kHeight * 4);
+        glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+        glReadPixels(0, 0, kWidth, kHeight, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
+        return rgba;
+    };
+    auto readDepth = [&] {
+        std::vector<float> d(std::size_t{kWidth} * kHeight);
+        glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+        glReadPixels(0, 0, kWidth, kHeight, GL_DEPTH_COMPONENT, GL_FLOAT, d.data());
+        return d;
+    };
 
     double partsDrawn = 0, partsTotal = 0;
     int frame = 0;
@@ -244,11 +285,7 @@ int main(int argc, char** argv) {
             t.rotation = glm::angleAxis(1.7f * a, glm::normalize(glm::vec3(1.0f, 2.0f, 0.5f)));
             if (dyncull::Status s = engine.setTransform(crates[i], t); !s) fail(s.message());
         }
-        glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-        glViewport(0, 0, kWidth, kHeight);
-        glClearColor(0.45f, 0.6f, 0.8f, 1.0f);
-        glClearDepth(0.0);  // reversed Z: 0 is the far plane
-        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+        clearFrame();
         auto stats = engine.renderFrame();
         if (!stats) fail(stats.error().message);
         partsDrawn += double(engine.visibleParts().size());
@@ -258,19 +295,58 @@ int main(int argc, char** argv) {
         glfwPollEvents();
     }
 
+    const std::vector<unsigned char> rgba = readFrame();
     if (!screenshot.empty()) {
-        std::vector<unsigned char> rgba(std::size_t{kWidth} * kHeight * 4);
-        glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
-        glReadPixels(0, 0, kWidth, kHeight, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
         stbi_flip_vertically_on_write(1);
         if (!stbi_write_png(screenshot.c_str(), kWidth, kHeight, 4, rgba.data(), kWidth * 4)) fail("cannot write " + screenshot);
     }
     std::printf("glfw_game: %d frames, %.1f of %.0f parts drawn a frame, %zu visible objects in the last%s%s\n", frame,
                 partsDrawn / std::max(frame, 1), partsTotal / std::max(frame, 1), engine.visibleObjects().size(),
                 screenshot.empty() ? "" : "; wrote ", screenshot.c_str());
-    made->reset();  // the engine before the context it borrows
+    int status = 0;
+    if (check) {
+        clearFrame();
+        drawEverything();
+        const std::vector<unsigned char> reference = readFrame();
+        std::size_t differ = 0;
+        for (std::size_t i = 0; i < rgba.size(); i += 4) differ += std::memcmp(&rgba[i], &reference[i], 4) != 0;
+        const double percent = 100.0 * double(differ) / double(kWidth * kHeight);
+        std::printf("check: %zu of %d pixels (%.4f%%) differ from drawing every object\n", differ, kWidth * kHeight, percent);
+        if (percent > 0.01) status = 1;
+
+        // The same frame through dyncull's own renderer: the same models, placements and camera.
+        auto own = dyncull::Engine::create(**gl);
+        if (!own) fail(own.error().message);
+        auto ownCrate = (*own)->addModel(box.shape, split);
+        auto ownWall = (*own)->addModel(slab.shape);
+        if (!ownCrate || !ownWall) fail("own renderer: cannot add the models");
+        const dyncull::SceneObjects& objects = engine.objects();
+        for (std::uint32_t i = 0; i < objects.slotCount(); ++i) {
+            if (!objects.alive(i)) continue;
+            const dyncull::ModelId model = objects.modelOf(i) == *crateModel ? *ownCrate : *ownWall;
+            if (auto h = (*own)->addObject(model, objects.transform(i)); !h) fail(h.error().message);
+        }
+        if (dyncull::Status s = (*own)->setCamera(camera); !s) fail(s.message());
+        clearFrame();
+        if (auto st = engine.renderFrame(); !st) fail(st.error().message);
+        const std::vector<float> gameDepth = readDepth();
+        clearFrame();
+        if (auto st = (*own)->renderFrame(); !st) fail(st.error().message);
+        const std::vector<float> ownDepth = readDepth();
+        // The game transforms in world space, dyncull relative to the eye: a few float
+        // roundings apart at most.
+        std::size_t depthDiffer = 0;
+        for (std::size_t i = 0; i < gameDepth.size(); ++i)
+            depthDiffer += std::abs(gameDepth[i] - ownDepth[i]) > 1e-5f * std::max(gameDepth[i], ownDepth[i]);
+        const double depthPercent = 100.0 * double(depthDiffer) / double(kWidth * kHeight);
+        std::printf("check: %zu of %d pixels (%.4f%%) differ in depth from dyncull's own renderer\n", depthDiffer,
+                    kWidth * kHeight, depthPercent);
+        if (depthPercent > 0.01) status = 1;
+        own->reset();
+    }
+    made->reset();  // the engines before the context they borrow
     gl->reset();
     glfwDestroyWindow(window);
     glfwTerminate();
-    return 0;
+    return status;
 }

@@ -28,7 +28,7 @@ cmake -S "$src/examples/glfw_game" -B "$work/glfw_game" -DCMAKE_PREFIX_PATH="$pr
   >"$work/configure_glfw.log"
 cmake --build "$work/glfw_game" -j2 >"$work/build_glfw.log"
 if command -v xvfb-run >/dev/null; then
-  xvfb-run -a "$work/glfw_game/glfw_game" --frames 30 --screenshot "$work/glfw_game.png"
+  xvfb-run -a "$work/glfw_game/glfw_game" --frames 30 --check --screenshot "$work/glfw_game.png"
   [[ -s "$work/glfw_game.png" ]] || { echo "FAIL: glfw_game wrote no screenshot" >&2; exit 1; }
 else
   echo "glfw_game: built; not run (no xvfb-run)"
