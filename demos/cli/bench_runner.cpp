@@ -206,6 +206,19 @@ bool applyQueriesSetting(const std::string& part, ModeSpec& m) {
 
 }  // namespace
 
+std::string approximationFamily(const ModeSpec& m) {
+    if (m.oracle) return {};
+    const SchedulerApproximations& a = m.scheduler.approx;
+    std::string family;
+    auto add = [&](const char* what) { family += (family.empty() ? "" : " + ") + std::string(what); };
+    if (a.errorBudgetPercent > 0)
+        add(a.budgetEarlySet ? "error budget, early set" : a.budgetRecount ? "error budget, recount" : "error budget");
+    if (m.queries.visiblePixelThreshold > 0) add("sample threshold");
+    if (a.smallFeaturePixels > 0) add("small features");
+    if (a.useLastFrameResults) add("latency");
+    return family;
+}
+
 Expected<ModeSpec> modeFromName(const std::string& name) {
     ModeSpec m = queriesMode(name);
     if (name == "vfc" || name == "vfc-noclusters") {
@@ -244,6 +257,7 @@ Expected<ModeSpec> modeFromName(const std::string& name) {
             return Error{"--modes: '" + name + "': queries-notight queries world boxes and takes no volume"};
     }
     if (Status s = validateSchedulerParams(m.scheduler); !s) return Error{"--modes: " + name + ": " + s.message()};
+    m.family = approximationFamily(m);
     return m;
 }
 
@@ -261,8 +275,8 @@ Expected<std::vector<ModeSpec>> modesFromList(const std::string& list) {
 }
 
 std::string sweepParamsHelp() {
-    return "pixel-threshold, max-skip, skip-per-visible, small-feature, max-in-flight, tile-size, auto-saving (percent); "
-           "error-budget (full; percent of the frame's pixels, decimals allowed)";
+    return "pixel-threshold, max-skip, skip-per-visible, small-feature, max-in-flight, tile-size, auto-saving (percent), "
+           "latency (0 or 1 frames); error-budget (full; percent of the frame's pixels, decimals allowed)";
 }
 
 Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec) {
@@ -282,6 +296,9 @@ Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec) {
             m.scheduler.approx.errorBudgetPercent = percent;
         } else if (!parseU32(text, v)) {
             return Error{"--param " + param + ": '" + text + "' is not a non-negative integer"};
+        } else if (param == "latency") {
+            if (v > 1) return Error{"--param latency: '" + text + "' is not 0 or 1 (frames of latency)"};
+            m.scheduler.approx.useLastFrameResults = v == 1;
         } else if (param == "pixel-threshold") {
             m.queries.visiblePixelThreshold = v;
         } else if (param == "max-skip") {
@@ -303,6 +320,12 @@ Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec) {
         if (Status s = validateSchedulerParams(m.scheduler); !s) return Error{"--param " + m.name + ": " + s.message()};
         for (const ModeSpec& o : out)
             if (o.name == m.name) return Error{"--param: value " + text + " given twice"};
+        // Every value of a parameter is one family (its 0 the curve's conservative end), named
+        // as approximationFamily names the approximation the parameter sets.
+        m.family = param == "error-budget"      ? "error budget"
+                   : param == "pixel-threshold" ? "sample threshold"
+                   : param == "small-feature"   ? "small features"
+                                                : param;
         out.push_back(std::move(m));
     }
     return out;

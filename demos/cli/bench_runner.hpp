@@ -30,7 +30,16 @@ struct ModeSpec {
     bool oracle = false;
     SchedulerParams scheduler;
     GlQueryParams queries;
+    /// The family of settings this mode belongs to, one curve in the speed-accuracy plot:
+    /// the approximations it uses (approximationFamily), or for a sweep of a conservative
+    /// parameter that parameter's name; empty for a conservative named mode.
+    std::string family;
 };
+
+/// The approximate settings `m` uses, named for the plots and reports ("error budget",
+/// "sample threshold", "small features", "latency", joined by " + " when combined);
+/// empty when the mode is conservative.
+std::string approximationFamily(const ModeSpec& m);
 
 /// A named mode: vfc, simple, full (two-phase, the default), queries (hardware queries),
 /// oracle; ablations of full: full-hzb, full-nohist, full-nocost; approximate full:
@@ -64,6 +73,8 @@ std::string modeNamesHelp();
 /// max-skip, skip-per-visible, small-feature, max-in-flight, tile-size, auto-saving
 /// (percent; queries with the auto volume). One mode per value, named "NAME=v". Error names
 /// the bad parameter or value.
+/// `sweep --param NAME=v1,v2,...` (given once per family): one mode per value, named
+/// "NAME=v", its family set. Error for an unknown name, a bad value, or a value twice.
 Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec);
 std::string sweepParamsHelp();
 

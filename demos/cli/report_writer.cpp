@@ -74,6 +74,7 @@ std::vector<ModeSummary> summarise(const BenchResult& r) {
         ModeSummary& s = out[m];
         s.name = r.modes[m].name;
         s.oracle = r.modes[m].oracle;
+        s.family = r.modes[m].family;
         s.frames = r.frames.size();
         std::vector<double> ms;
         for (const auto& row : r.frames) {
@@ -174,11 +175,16 @@ std::vector<ModeSummary> summarise(const BenchResult& r) {
     }
     // Pareto front over (mean ms, mean % pixels wrong) among real modes: a mode is on it
     // unless another is no slower and no less accurate, and strictly better in one.
+    // The same within each family of settings: that family's curve.
+    auto dominates = [](const ModeSummary& b, const ModeSummary& a) {
+        return &b != &a && b.msMean <= a.msMean && b.pctWrongMean <= a.pctWrongMean &&
+               (b.msMean < a.msMean || b.pctWrongMean < a.pctWrongMean);
+    };
     for (ModeSummary& a : out) {
         if (a.oracle) continue;
-        a.pareto = std::none_of(out.begin(), out.end(), [&](const ModeSummary& b) {
-            return !b.oracle && &b != &a && b.msMean <= a.msMean && b.pctWrongMean <= a.pctWrongMean &&
-                   (b.msMean < a.msMean || b.pctWrongMean < a.pctWrongMean);
+        a.pareto = std::none_of(out.begin(), out.end(), [&](const ModeSummary& b) { return !b.oracle && dominates(b, a); });
+        a.familyFront = !a.family.empty() && std::none_of(out.begin(), out.end(), [&](const ModeSummary& b) {
+            return !b.oracle && b.family == a.family && dominates(b, a);
         });
     }
     return out;
@@ -312,6 +318,25 @@ PlotOutcome writePlots(const BenchResult& r, const std::vector<ModeSummary>& sum
         if (Status s = closeChecked(f, dir / "plot_pareto.dat"); !s) return skipped(s);
         if (Status s = closeChecked(front, dir / "plot_front.dat"); !s) return skipped(s);
     }
+    // One data block per family of approximate settings (gnuplot's `index`): its front, by time.
+    std::vector<std::string> families;
+    for (const ModeSummary& s : summary)
+        if (!s.family.empty() && std::find(families.begin(), families.end(), s.family) == families.end())
+            families.push_back(s.family);
+    {
+        std::ofstream f;
+        if (Status s = openChecked(f, dir / "plot_families.dat"); !s) return skipped(s);
+        for (const std::string& family : families) {
+            f << "# family: " << family << " (ms_mean pixels_wrong_pct_mean, its Pareto front by time)\n";
+            std::vector<const ModeSummary*> pts;
+            for (const ModeSummary& s : summary)
+                if (s.family == family && s.familyFront) pts.push_back(&s);
+            std::sort(pts.begin(), pts.end(), [](auto* a, auto* b) { return a->msMean < b->msMean; });
+            for (auto* s : pts) f << s->msMean << ' ' << s->pctWrongMean << '\n';
+            f << "\n\n";
+        }
+        if (Status s = closeChecked(f, dir / "plot_families.dat"); !s) return skipped(s);
+    }
     std::string names;
     for (const ModeSpec& m : r.modes) names += (names.empty() ? "" : " ") + m.name;
     const std::string title = r.scene + ", " + std::to_string(r.width) + "x" + std::to_string(r.height) + ", " +
@@ -346,9 +371,13 @@ PlotOutcome writePlots(const BenchResult& r, const std::vector<ModeSummary>& sum
        << "set logscale y\nset format y '%g'\natleast(v) = v > 1e-5 ? v : 1e-5\n"
        << "set offsets graph 0.08, graph 0.15, 0, 0\n"
        << "plot " << gpQuote((dir / "plot_front.dat").string())
-       << " using 1:(atleast($2)) with linespoints lw 2 pt 7 ps 1.6 lc rgb '#d62728' title 'Pareto front', \\\n"
-       << "     " << gpQuote((dir / "plot_pareto.dat").string())
-       << " using 2:(atleast($3)) with points pt 6 ps 1.4 lc rgb '#1f77b4' title 'mode / setting', \\\n"
+       << " using 1:(atleast($2)) with lines lw 6 lc rgb '#e0e0e0' title 'Pareto front of all modes', \\\n";
+    for (std::size_t i = 0; i < families.size(); ++i)
+        gp << "     " << gpQuote((dir / "plot_families.dat").string()) << " index " << i
+           << " using 1:(atleast($2)) with linespoints lw 2 pt 7 ps 1.3 lc " << i + 1 << " title "
+           << gpQuote(families[i]) << ", \\\n";
+    gp << "     " << gpQuote((dir / "plot_pareto.dat").string())
+       << " using 2:(atleast($3)) with points pt 6 ps 1.4 lc rgb '#404040' title 'mode / setting', \\\n"
        << "     '' using 2:(atleast($3)):1 with labels left offset 0.8,0.6 notitle\n";
     if (r.streaming.frames > 0)
         gp << "set output " << gpQuote((dir / "resident_memory.png").string()) << "\n"

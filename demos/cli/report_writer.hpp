@@ -46,6 +46,8 @@ struct ModeSummary {
     double pairedVsBest = 0;
     LeafVolumeTotals leaves;       ///< world-space leaf volumes at the last frame (leaves == 0: n/a)
     bool pareto = false;  ///< on the speed-accuracy Pareto front (the oracle never is: it is not a real mode)
+    std::string family;   ///< ModeSpec::family: the curve it belongs to in the speed-accuracy plot
+    bool familyFront = false;  ///< on its family's own Pareto front (the family's curve)
     // The approximate settings' claims against what was measured (ClaimCheck).
     double claimedPctMean = 0, claimedPctMax = 0;  ///< claimed error, % of the frame's pixels
     double lostPctMax = 0;                          ///< pixels lost (unlike vfc where the truth's part was not drawn), worst frame, %

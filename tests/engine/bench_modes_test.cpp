@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "bench_runner.hpp"
+#include "report_writer.hpp"
 
 namespace dyncull::cli {
 namespace {
@@ -83,6 +84,70 @@ TEST(BenchModes, BadNamesAreErrorsNamingThePart) {
     EXPECT_FALSE(modesFromList("full,full"));
     EXPECT_FALSE(modesFromList("full,,vfc"));
     EXPECT_EQ(modesFromList("vfc,full,thr16+latency1")->size(), 3u);
+}
+
+TEST(BenchModes, FamiliesNameTheApproximations) {
+    for (const char* conservative : {"vfc", "full", "queries", "full-hzb", "front20", "oracle"})
+        EXPECT_EQ(modeFromName(conservative)->family, "") << conservative;
+    EXPECT_EQ(modeFromName("budget0.1")->family, "error budget");
+    EXPECT_EQ(modeFromName("budgetearly0.1")->family, "error budget, early set");
+    EXPECT_EQ(modeFromName("budgetrecount0.1")->family, "error budget, recount");
+    EXPECT_EQ(modeFromName("thr16")->family, "sample threshold");
+    EXPECT_EQ(modeFromName("small16")->family, "small features");
+    EXPECT_EQ(modeFromName("latency1")->family, "latency");
+    EXPECT_EQ(modeFromName("thr16+latency1")->family, "sample threshold + latency");
+}
+
+TEST(BenchModes, EverySweptValueIsInItsParametersFamily) {
+    auto budget = sweepModes("error-budget=0.05,0.5");
+    ASSERT_TRUE(budget) << budget.error().message;
+    ASSERT_EQ(budget->size(), 2u);
+    EXPECT_EQ((*budget)[0].name, "error-budget=0.05");
+    for (const ModeSpec& m : *budget) EXPECT_EQ(m.family, "error budget");
+    // The conservative end of a curve (0) stays on its family's curve.
+    auto threshold = sweepModes("pixel-threshold=0,16");
+    ASSERT_TRUE(threshold);
+    for (const ModeSpec& m : *threshold) EXPECT_EQ(m.family, "sample threshold");
+    auto latency = sweepModes("latency=0,1");
+    ASSERT_TRUE(latency);
+    EXPECT_FALSE((*latency)[0].scheduler.approx.useLastFrameResults);
+    EXPECT_TRUE((*latency)[1].scheduler.approx.useLastFrameResults);
+    EXPECT_EQ((*latency)[1].family, "latency");
+    EXPECT_EQ(sweepModes("max-skip=2,4")->front().family, "max-skip");
+    EXPECT_FALSE(sweepModes("latency=2"));
+    EXPECT_FALSE(sweepModes("error-budget=0.1,0.1"));
+}
+
+// Each family's curve is its own Pareto front: a setting another of the same family beats
+// on time and error is off the curve, even if it beats every other family.
+TEST(BenchModes, EachFamilysCurveIsItsOwnFront) {
+    BenchResult r;
+    r.width = 100;
+    r.height = 10;
+    const std::vector<std::pair<std::string, std::pair<double, double>>> modes = {
+        {"vfc", {10.0, 0.0}},         {"full", {6.0, 0.0}},        {"budget0.1", {5.0, 0.05}},
+        {"budget0.5", {5.5, 0.2}},    {"budget1", {4.0, 0.4}},     {"thr16", {4.5, 0.45}},
+        {"thr64", {3.0, 1.0}}};
+    std::vector<ModeFrame> row;
+    for (const auto& [name, timeAndError] : modes) {
+        r.modes.push_back(modeFromName(name).take());
+        ModeFrame f;
+        f.stats.frameMs = timeAndError.first;
+        f.image.percentDiffering = timeAndError.second;
+        row.push_back(f);
+    }
+    r.frames.push_back(row);
+    r.truth.resize(1);
+    const std::vector<ModeSummary> s = summarise(r);
+    auto at = [&](const char* name) { return s[std::size_t(findMode(s, name))]; };
+    EXPECT_TRUE(at("budget0.1").familyFront);
+    EXPECT_FALSE(at("budget0.5").familyFront) << "slower and worse than budget0.1";
+    EXPECT_TRUE(at("budget1").familyFront);
+    EXPECT_TRUE(at("thr16").familyFront) << "budget1 beats it, but is of another family";
+    EXPECT_FALSE(at("thr16").pareto);
+    EXPECT_TRUE(at("thr64").familyFront && at("thr64").pareto);
+    EXPECT_FALSE(at("full").familyFront) << "conservative modes are no family's curve";
+    EXPECT_TRUE(at("full").pareto);
 }
 
 }  // namespace
