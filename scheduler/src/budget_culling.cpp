@@ -26,7 +26,7 @@ void QueryScheduler::spendErrorBudget(Frame& f) {
         const std::uint32_t samples = rasterSamples_[i];
         // Occluded ones cost nothing and are culled anyway; unknown counts cannot be bounded.
         if (rasterAnswers_[i] == QueryResult::Occluded || samples == kUnknownSamples || samples > budget - spent) continue;
-        budgetOrder_.push_back({double(subtreeTriangles(f, candidates_[i].ref)) / double(std::max(samples, 1u)), i});
+        budgetOrder_.push_back({double(subtreeTriangles(f, candidates_[i])) / double(std::max(samples, 1u)), i});
     }
     // Most drawing saved per sample first; ties by candidate order (front to back), so
     // the choice is deterministic.

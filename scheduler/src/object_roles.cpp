@@ -64,9 +64,7 @@ void QueryScheduler::drawOccludees(Frame& f) {
             drawNode(f, root, false);
             continue;
         }
-        const QueryVolume volume = params_.features.useTightVolumes
-                                       ? objectNodeVolume(objs, root, params_.tuning.volume, params_.tuning.autoVolumeSaving)
-                                       : QueryVolume::fromAabb(box);
+        const QueryVolume volume = testedVolume(f, root);
         ScreenRect rect;
         float nearest = 1.0f;
         if (!f.screen.volumeDepth(volume, rect, nearest) || box.contains(f.camera().position)) {
@@ -77,14 +75,14 @@ void QueryScheduler::drawOccludees(Frame& f) {
             ++f.stats.frustumCulled;
             f.note(root, box, NodeState::FrustumCulled);
         } else {
-            candidates_.push_back({root, volume});
+            candidates_.push_back(root);
         }
     }
     if (candidates_.empty()) return;
     // One batch: occludees draw no depth, so none can hide another.
     rasterTest(f, candidates_);
     for (std::size_t i = 0; i < candidates_.size(); ++i) {
-        const NodeRef root = candidates_[i].ref;
+        const NodeRef root = candidates_[i];
         if (rasterAnswers_[i] == QueryResult::Occluded) {
             ++f.stats.queriesOccluded;
             f.note(root, objs.worldBox(root.object), NodeState::Occluded);

@@ -132,9 +132,7 @@ void QueryScheduler::lateTraversal(Frame& f, bool testing, bool haveDepth, bool 
         float nearest = 1.0f;
         // Object nodes by their own volume (a transformed box or k-DOP, tighter than the
         // world box of a rotated part), scene nodes by their box; both grown by rounding.
-        const QueryVolume volume = ref.isSceneNode() || !params_.features.useTightVolumes
-                                       ? QueryVolume::fromAabb(box)
-                                       : objectNodeVolume(objs, ref, params_.tuning.volume, params_.tuning.autoVolumeSaving);
+        const QueryVolume volume = testedVolume(f, ref);
         const bool inFront = f.screen.volumeDepth(volume, rect, nearest);
         bool certain = false;  // visible without any test (near plane, camera inside)
         if (!inFront || box.contains(f.camera().position)) {
@@ -172,10 +170,10 @@ void QueryScheduler::lateTraversal(Frame& f, bool testing, bool haveDepth, bool 
             } else if (sinceAnswer <= params_.tuning.history.maxSkipFrames && !worthTesting(f, ref, rect, refreshOccludedRate_)) {
                 ++f.stats.skippedByCost;
             } else {
-                refresh_.push_back({ref, volume});
+                refresh_.push_back(ref);
             }
         } else if (raster && !certain && (worthTesting(f, ref, rect, candidateOccludedRate_) || exploring(ref))) {
-            candidates_.push_back({ref, volume});
+            candidates_.push_back(ref);
         } else {
             if (raster && !certain) ++f.stats.skippedByCost;
             note(certain ? NodeState::VisibleNear : testing && !raster ? NodeState::VisibleQueried : NodeState::VisibleCheaper);
@@ -231,7 +229,7 @@ void QueryScheduler::testCandidates(Frame& f, bool triangles) {
 void QueryScheduler::settleCandidates(Frame& f, bool triangles) {
     const SceneObjects& objs = f.objects;
     for (std::size_t i = 0; i < candidates_.size(); ++i) {
-        const NodeRef ref = candidates_[i].ref;
+        const NodeRef ref = candidates_[i];
         NodeHistory& h = history_.at(ref, objs);
         if (budgetCulled_[i] == kBudgetLater) continue;
         if (budgetCulled_[i] == kBudgetCulled) {
@@ -268,8 +266,8 @@ void QueryScheduler::testRefresh(Frame& f) {
     for (std::size_t i = 0; i < refresh_.size(); ++i) {
         const bool visible = rasterAnswers_[i] != QueryResult::Occluded &&
                              !(budget && rasterSamples_[i] != kUnknownSamples && rasterSamples_[i] <= budgetPixels);
-        if (!visible) culledTriangles_ += subtreeTriangles(f, refresh_[i].ref);  // not drawn early next frame
-        history_.recordAnswer(history_.at(refresh_[i].ref, objs), visible, f.index);
+        if (!visible) culledTriangles_ += subtreeTriangles(f, refresh_[i]);  // not drawn early next frame
+        history_.recordAnswer(history_.at(refresh_[i], objs), visible, f.index);
     }
 }
 
@@ -357,18 +355,35 @@ bool QueryScheduler::exploring(NodeRef ref) const {
     return ((hashNode(ref) >> 5) + frame_) % 8 == 0;
 }
 
-void QueryScheduler::rasterTest(Frame& f, const std::vector<TestedPart>& parts, bool countSamples) {
+QueryVolume QueryScheduler::testedVolume(const Frame& f, NodeRef ref) const {
+    if (ref.isSceneNode() || !params_.features.useTightVolumes) return QueryVolume::fromAabb(f.tree.worldBox(ref));
+    return objectNodeVolume(f.objects, ref, params_.tuning.volume, params_.tuning.autoVolumeSaving);
+}
+
+void QueryScheduler::rasterTest(Frame& f, const std::vector<NodeRef>& parts, bool countSamples) {
+    // Batches of at most this many volumes, all drawn before the first is read: the
+    // volumes (and the backend's streams) are held for one batch at a time, and a batch
+    // of a typical frame's tests is one draw.
+    constexpr std::size_t kRasterBatchVolumes = 2048;
     const auto t0 = SchedulerClock::now();
-    rasterVolumes_.clear();
-    for (const TestedPart& p : parts) rasterVolumes_.push_back(p.volume);
     rasterAnswers_.assign(parts.size(), QueryResult::Visible);
     rasterSamples_.assign(countSamples ? parts.size() : 0, kUnknownSamples);
-    const BatchId batch = f.backend.testVolumes(rasterVolumes_, countSamples);
-    if (batch != kNoBatch) {
+    rasterBatches_.clear();
+    for (std::size_t start = 0; start < parts.size(); start += kRasterBatchVolumes) {
+        const std::size_t end = std::min(parts.size(), start + kRasterBatchVolumes);
+        rasterVolumes_.clear();
+        for (std::size_t i = start; i < end; ++i) rasterVolumes_.push_back(testedVolume(f, parts[i]));
+        rasterBatches_.push_back(f.backend.testVolumes(rasterVolumes_, countSamples));
+    }
+    for (std::size_t b = 0; b < rasterBatches_.size(); ++b) {
+        if (rasterBatches_[b] == kNoBatch) continue;  // answers stay Visible
+        const std::size_t start = b * kRasterBatchVolumes, count = std::min(kRasterBatchVolumes, parts.size() - start);
         // Nothing else to do meanwhile: wait.
-        f.backend.collectVolumes(batch, rasterAnswers_, params_.tuning.queryTimeoutMs, rasterSamples_);
+        f.backend.collectVolumes(rasterBatches_[b], std::span(rasterAnswers_).subspan(start, count),
+                                 params_.tuning.queryTimeoutMs,
+                                 countSamples ? std::span(rasterSamples_).subspan(start, count) : std::span<std::uint32_t>{});
         ++f.stats.rasterBatches;
-        f.stats.rasterTests += static_cast<std::uint32_t>(parts.size());
+        f.stats.rasterTests += static_cast<std::uint32_t>(count);
     }
     f.stats.rasterMs += msSince(t0);
 }

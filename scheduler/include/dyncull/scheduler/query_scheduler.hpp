@@ -363,11 +363,13 @@ private:
     // frames; the parts for the batched raster test and its answers.
     std::vector<float> depth_;
     DepthPyramid pyramid_;
-    struct TestedPart {
-        NodeRef ref;
-        QueryVolume volume;  // world space, as the pyramid tested it
-    };
-    std::vector<TestedPart> candidates_, refresh_;
+    // Parts for the batched raster test. Their volumes are rebuilt batch by batch
+    // (testedVolume) rather than kept: a k-DOP is 860 bytes, and a frame without history
+    // has tens of thousands of candidates.
+    std::vector<NodeRef> candidates_, refresh_;
+    /// The volume `ref` is tested with in two-phase (world space): its world box for a
+    /// scene node or without tight volumes, else its own volume under its object's matrix.
+    QueryVolume testedVolume(const Frame& f, NodeRef ref) const;
     /// The cost model's measured rates of "occluded" answers, for parts new this frame and
     /// for parts drawn early and tested again (moving averages over frames), and for the
     /// triangle tests of parts whose volumes passed.
@@ -405,13 +407,14 @@ private:
     bool worthTesting(const Frame& f, NodeRef ref, const ScreenRect& rect, double occludedRate);
     /// True for the new parts tested this frame whatever the cost model expects.
     bool exploring(NodeRef ref) const;
-    std::vector<QueryVolume> rasterVolumes_;
+    std::vector<QueryVolume> rasterVolumes_;  // one batch's volumes (kRasterBatchVolumes at most)
+    std::vector<BatchId> rasterBatches_;
     std::vector<QueryResult> rasterAnswers_;
     std::vector<std::uint32_t> rasterSamples_;  // with `countSamples`
     /// One batched raster test of `parts`' volumes, answers in rasterAnswers_ (all Visible
     /// if the backend has no such test) and with `countSamples` each volume's samples in
     /// rasterSamples_, waiting for them: nothing else is left to do.
-    void rasterTest(Frame& f, const std::vector<TestedPart>& parts, bool countSamples = false);
+    void rasterTest(Frame& f, const std::vector<NodeRef>& parts, bool countSamples = false);
     /// The error budget (budget_culling.cpp): turns the Visible answers of candidates_
     /// that fit in the frame's budget into Occluded, marking them in budgetCulled_, and
     /// charges their samples to the frame's claim.
@@ -422,7 +425,7 @@ private:
     /// waiting to be counted again (budgetRecount).
     enum : std::uint8_t { kBudgetNo, kBudgetCulled, kBudgetLater };
     std::vector<std::uint8_t> budgetCulled_;
-    std::vector<TestedPart> waitingParts_;
+    std::vector<NodeRef> waitingParts_;
     /// Culls, draws or hands on to triangle tests each candidate by its answer.
     void settleCandidates(Frame& f, bool triangles);
     std::vector<std::pair<double, std::uint32_t>> budgetOrder_;  // (drawing saved per sample, candidate)
