@@ -256,14 +256,20 @@ void StreamedObjects::beginFrame(const Camera& camera) {
         predicted.target += motion;
     }
     predicted.fovYRadians = std::min(camera.fovYRadians * s.options.widenFov, 2.8f);
-    s.previous = camera;
     const Frustum now = Frustum::fromCamera(camera), next = Frustum::fromCamera(predicted);
 
+    // A leaf in GL buffers is drawn from there: main memory is for the leaves that are not.
+    // Last frame's drawn leaves first (still drawn, mostly), then the leaves entering the
+    // view (outside last frame's frustum, so untested), then the ones last frame's frustum
+    // held but the culler left undrawn (hidden then: shown again only where something
+    // moved out of their way), each group nearest first.
+    const std::optional<Frustum> before = s.previous ? std::optional(Frustum::fromCamera(*s.previous)) : std::nullopt;
     s.wanted.clear();
     for (std::uint32_t leaf : s.urgent) s.want(leaf);
-    for (std::uint32_t leaf : s.lastDrawn) s.want(leaf);
-    // Leaves in either frustum, nearest first, through the tree (a subtree outside both is skipped).
+    for (std::uint32_t leaf : s.lastDrawn)
+        if (!s.gpu[leaf].resident) s.want(leaf);
     struct Near {
+        bool hiddenBefore;
         float distance;
         std::uint32_t leaf;
     };
@@ -278,11 +284,17 @@ void StreamedObjects::beginFrame(const Camera& camera) {
             for (std::uint32_t c = 0; c < node.childCount; ++c) stack.push_back(node.firstChild + c);
             continue;
         }
+        const std::uint32_t leaf = s.leafOfNode[k];
+        if (s.gpu[leaf].resident) continue;
         const glm::vec3 nearest = glm::clamp(camera.position, node.box.min, node.box.max);
-        found.push_back({glm::distance(nearest, camera.position), s.leafOfNode[k]});
+        const bool hiddenBefore = before && !before->outside(node.box) && s.gpu[leaf].frame != s.frame - 1;
+        found.push_back({hiddenBefore, glm::distance(nearest, camera.position), leaf});
     }
-    std::sort(found.begin(), found.end(), [](const Near& a, const Near& b) { return a.distance < b.distance; });
+    std::sort(found.begin(), found.end(), [](const Near& a, const Near& b) {
+        return a.hiddenBefore != b.hiddenBefore ? b.hiddenBefore : a.distance < b.distance;
+    });
     for (const Near& f : found) s.want(f.leaf);
+    s.previous = camera;
     for (std::uint32_t leaf : s.wanted) s.listed[leaf] = 0;
     s.urgent.clear();
     s.cache->prefetch(s.wanted);
