@@ -66,13 +66,17 @@ struct StreamedObjects::State {
 
     std::size_t gpuBudget() const { return options.gpuBytes ? options.gpuBytes : SIZE_MAX; }
 
-    /// Releases least recently drawn leaves not drawn this frame until `bytes` more fit.
+    /// Releases least recently drawn leaves drawn neither this frame nor the last until
+    /// `bytes` more fit. Last frame's leaves are kept: most are drawn again later in this
+    /// frame, and releasing them for a new leaf would make each frame read them all again
+    /// when the budget is smaller than a frame's leaves (the new leaf is drawn from a
+    /// transient copy instead).
     bool makeGpuRoom(std::size_t bytes) {
         while (gpuBytes + bytes > gpuBudget()) {
             std::size_t victim = SIZE_MAX;
             for (std::size_t k = 0; k < gpuResident.size(); ++k) {
                 const Gpu& g = gpu[gpuResident[k]];
-                if (g.frame == frame) continue;
+                if (g.frame + 1 >= frame) continue;
                 if (victim == SIZE_MAX || g.frame < gpu[gpuResident[victim]].frame) victim = k;
             }
             if (victim == SIZE_MAX) return false;
@@ -256,23 +260,24 @@ void StreamedObjects::beginFrame(const Camera& camera) {
         predicted.target += motion;
     }
     predicted.fovYRadians = std::min(camera.fovYRadians * s.options.widenFov, 2.8f);
+    s.previous = camera;
     const Frustum now = Frustum::fromCamera(camera), next = Frustum::fromCamera(predicted);
 
     // A leaf in GL buffers is drawn from there: main memory is for the leaves that are not.
-    // Last frame's drawn leaves first (still drawn, mostly), then the leaves entering the
-    // view (outside last frame's frustum, so untested), then the ones last frame's frustum
-    // held but the culler left undrawn (hidden then: shown again only where something
-    // moved out of their way), each group nearest first.
-    const std::optional<Frustum> before = s.previous ? std::optional(Frustum::fromCamera(*s.previous)) : std::nullopt;
+    // Last frame's drawn leaves first (drawn again, mostly), then the leaves in either
+    // frustum, found through the tree (a subtree outside both is skipped): first those
+    // last frame tested and found hidden (the traversal reached them, so they lie near
+    // what is visible, where disocclusion shows new leaves), then the rest, each nearest first.
     s.wanted.clear();
     for (std::uint32_t leaf : s.urgent) s.want(leaf);
     for (std::uint32_t leaf : s.lastDrawn)
         if (!s.gpu[leaf].resident) s.want(leaf);
     struct Near {
-        bool hiddenBefore;
+        bool testedHidden;
         float distance;
         std::uint32_t leaf;
     };
+    const QueryScheduler& culler = s.engine.scheduler();
     std::vector<Near> found;
     std::vector<std::uint32_t> stack{0};
     while (!stack.empty()) {
@@ -287,14 +292,13 @@ void StreamedObjects::beginFrame(const Camera& camera) {
         const std::uint32_t leaf = s.leafOfNode[k];
         if (s.gpu[leaf].resident) continue;
         const glm::vec3 nearest = glm::clamp(camera.position, node.box.min, node.box.max);
-        const bool hiddenBefore = before && !before->outside(node.box) && s.gpu[leaf].frame != s.frame - 1;
-        found.push_back({hiddenBefore, glm::distance(nearest, camera.position), leaf});
+        const bool testedHidden = culler.testedHiddenLastFrame(NodeRef{s.objectOfLeaf[leaf].index, 0}, s.engine.objects());
+        found.push_back({testedHidden, glm::distance(nearest, camera.position), leaf});
     }
     std::sort(found.begin(), found.end(), [](const Near& a, const Near& b) {
-        return a.hiddenBefore != b.hiddenBefore ? b.hiddenBefore : a.distance < b.distance;
+        return a.testedHidden != b.testedHidden ? a.testedHidden : a.distance < b.distance;
     });
     for (const Near& f : found) s.want(f.leaf);
-    s.previous = camera;
     for (std::uint32_t leaf : s.wanted) s.listed[leaf] = 0;
     s.urgent.clear();
     s.cache->prefetch(s.wanted);

@@ -38,6 +38,15 @@ NodeHistory& VisibilityHistory::at(NodeRef ref, const SceneObjects& objects) {
     return objectNodes_[objectBase_[slot] + ref.node];
 }
 
+const NodeHistory* VisibilityHistory::find(NodeRef ref, const SceneObjects& objects) const {
+    if (ref.isSceneNode()) return ref.node < scene_.size() ? &scene_[ref.node] : nullptr;
+    const std::uint32_t slot = ref.object;
+    if (slot >= objectBase_.size() || objectBase_[slot] == kInvalidIndex || objectModel_[slot] != objects.modelOf(slot) ||
+        objectGen_[slot] != objects.handle(slot).generation || ref.node >= objects.model(objects.modelOf(slot)).nodes.size())
+        return nullptr;
+    return &objectNodes_[objectBase_[slot] + ref.node];
+}
+
 void VisibilityHistory::clear() {
     scene_.clear();
     objectNodes_.clear();

@@ -259,6 +259,44 @@ TEST(QueryScheduler, OccludedNodesAreQueriedAgainEveryFrame) {
     }
 }
 
+// What the streamed read-ahead asks the culler: which nodes last frame reached, tested
+// and found hidden. Drawn nodes and nodes never reached say no; so does a reused slot.
+TEST(QueryScheduler, TestedHiddenLastFrameNamesExactlyTheNodesAQueryHid) {
+    TestScene s(3, 3);
+    ScriptedBackend b;
+    // Object-sized volumes right of centre are hidden; scene nodes (larger) never are.
+    b.rule = [](const QueryVolume& v) {
+        Aabb box;
+        for (const glm::vec3& p : v.points()) box.extend(p);
+        const glm::vec3 size = box.max - box.min;
+        return std::max({size.x, size.y, size.z}) < 0.9f && box.center().x > 0.5f ? QueryResult::Occluded
+                                                                                   : QueryResult::Visible;
+    };
+    SchedulerParams p = queriesParams();
+    p.features.useOccupancyAccept = false;
+    QueryScheduler sched(p);
+    TwoLevelTree tree(s.bsp, s.objects);
+    RecordingSink sink;
+    for (const ObjectHandle h : s.handles) EXPECT_FALSE(sched.testedHiddenLastFrame(NodeRef{h.index, 0}, s.objects));
+    sched.cullFrame(tree, frontCamera(), 640, 320, b, sink);
+    std::size_t hidden = 0;
+    for (const ObjectHandle h : s.handles) {
+        const bool right = s.objects.worldBox(h.index).center().x > 0.5f;
+        const bool testedHidden = sched.testedHiddenLastFrame(NodeRef{h.index, 0}, s.objects);
+        EXPECT_EQ(testedHidden, right && sink.drawn.count(h.index) == 0) << h.index;
+        EXPECT_EQ(sink.drawn.count(h.index) == 0, right) << h.index;
+        hidden += testedHidden;
+    }
+    EXPECT_EQ(hidden, 3u);
+    // A slot reused by a new object has no history of the old one.
+    const ObjectHandle gone = s.handles.back();
+    const Transform where = s.objects.transform(gone.index);
+    ASSERT_TRUE(s.objects.removeObject(gone).ok());
+    const ObjectHandle reused = s.objects.addObject(s.objects.modelOf(s.handles.front().index), where).take();
+    ASSERT_EQ(reused.index, gone.index);
+    EXPECT_FALSE(sched.testedHiddenLastFrame(NodeRef{reused.index, 0}, s.objects));
+}
+
 TEST(QueryScheduler, BatchesHoldOnlyNonOverlappingRectangles) {
     TestScene s(6, 6);
     ScriptedBackend b;

@@ -273,6 +273,13 @@ public:
     /// (cleared at the start of each frame). The caller owns the vector; nullptr stops.
     void setTrace(std::vector<NodeTrace>* trace) { trace_ = trace; }
     std::uint32_t frameIndex() const { return frame_; }
+    /// True if the newest frame tested `ref` (a live node of `objects`) and found it hidden:
+    /// it lay in the frustum, reached by the traversal, behind what was drawn. A node never
+    /// reached (its subtree culled whole, or outside the frustum) or drawn gives false.
+    bool testedHiddenLastFrame(NodeRef ref, const SceneObjects& objects) const {
+        const NodeHistory* h = history_.find(ref, objects);
+        return h && frame_ > 0 && h->lastQueryFrame == frame_ && !h->lastVisible;
+    }
 
     /// One frame's borrowed state, passed through every stage (cull_frame.hpp).
     struct Frame;

@@ -39,6 +39,9 @@ class VisibilityHistory {
 public:
     /// Record for `ref`, creating it (never seen: lastVisible false) if needed.
     NodeHistory& at(NodeRef ref, const SceneObjects& objects);
+    /// The record for `ref` if there is one for the object as it is now (same generation
+    /// and model), else nullptr; never creates one.
+    const NodeHistory* find(NodeRef ref, const SceneObjects& objects) const;
     void clear();
 
     void recordAnswer(NodeHistory& h, bool visible, std::uint32_t frame) const;
