@@ -265,15 +265,17 @@ void StreamedObjects::beginFrame(const Camera& camera) {
 
     // A leaf in GL buffers is drawn from there: main memory is for the leaves that are not.
     // Last frame's drawn leaves first (drawn again, mostly), then the leaves in either
-    // frustum, found through the tree (a subtree outside both is skipped): first those
-    // last frame tested and found hidden (the traversal reached them, so they lie near
-    // what is visible, where disocclusion shows new leaves), then the rest, each nearest first.
+    // frustum, found through the tree (a subtree outside both is skipped), in the order the
+    // culler's history makes likely to show next: the most recently visible first (what
+    // the camera passes shows again), then those last frame tested and found hidden (the
+    // traversal reached them, so they lie next to what is visible), then nearest first.
     s.wanted.clear();
     for (std::uint32_t leaf : s.urgent) s.want(leaf);
     for (std::uint32_t leaf : s.lastDrawn)
         if (!s.gpu[leaf].resident) s.want(leaf);
     struct Near {
         bool testedHidden;
+        std::uint32_t lastVisible;  // the culler's frame it was last visible in (0: never)
         float distance;
         std::uint32_t leaf;
     };
@@ -292,11 +294,14 @@ void StreamedObjects::beginFrame(const Camera& camera) {
         const std::uint32_t leaf = s.leafOfNode[k];
         if (s.gpu[leaf].resident) continue;
         const glm::vec3 nearest = glm::clamp(camera.position, node.box.min, node.box.max);
-        const bool testedHidden = culler.testedHiddenLastFrame(NodeRef{s.objectOfLeaf[leaf].index, 0}, s.engine.objects());
-        found.push_back({testedHidden, glm::distance(nearest, camera.position), leaf});
+        const NodeHistory* h = culler.history(NodeRef{s.objectOfLeaf[leaf].index, 0}, s.engine.objects());
+        found.push_back({h && culler.testedHiddenLastFrame(*h), h ? h->lastVisibleFrame : 0u,
+                         glm::distance(nearest, camera.position), leaf});
     }
     std::sort(found.begin(), found.end(), [](const Near& a, const Near& b) {
-        return a.testedHidden != b.testedHidden ? a.testedHidden : a.distance < b.distance;
+        if (a.lastVisible != b.lastVisible) return a.lastVisible > b.lastVisible;
+        if (a.testedHidden != b.testedHidden) return a.testedHidden;
+        return a.distance < b.distance;
     });
     for (const Near& f : found) s.want(f.leaf);
     for (std::uint32_t leaf : s.wanted) s.listed[leaf] = 0;

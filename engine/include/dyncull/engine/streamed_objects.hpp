@@ -77,8 +77,11 @@ public:
     StreamedObjects(const StreamedObjects&) = delete;
     StreamedObjects& operator=(const StreamedObjects&) = delete;
 
-    /// Before a frame drawn from `camera` (world space): hands the read-ahead its list, the
-    /// leaves drawn last frame first, then those in the predicted frustum, nearest first.
+    /// Before a frame drawn from `camera` (world space): hands the read-ahead its list of
+    /// leaves not in GL buffers: those drawn last frame first, then those in the current or
+    /// predicted frustum, ordered by the main view's culler history (most recently visible,
+    /// then tested hidden last frame) and then nearest first. A culler without history for
+    /// the leaves (another scheduler culls them) leaves the order nearest first.
     void beginFrame(const Camera& camera);
     /// After the frame (renderFrame or several views of it): its streaming counters, or the
     /// first error a draw met (a corrupt leaf, naming the file and the leaf).

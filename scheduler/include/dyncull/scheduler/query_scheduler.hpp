@@ -276,10 +276,15 @@ public:
     /// True if the newest frame tested `ref` (a live node of `objects`) and found it hidden:
     /// it lay in the frustum, reached by the traversal, behind what was drawn. A node never
     /// reached (its subtree culled whole, or outside the frustum) or drawn gives false.
+    /// The visibility record of `ref` (a live node of `objects`), or nullptr if the culler
+    /// has none for the object as it is now. Valid until the next cullFrame.
+    const NodeHistory* history(NodeRef ref, const SceneObjects& objects) const { return history_.find(ref, objects); }
     bool testedHiddenLastFrame(NodeRef ref, const SceneObjects& objects) const {
         const NodeHistory* h = history_.find(ref, objects);
-        return h && frame_ > 0 && h->lastQueryFrame == frame_ && !h->lastVisible;
+        return h && testedHiddenLastFrame(*h);
     }
+    /// The same for a record history() returned.
+    bool testedHiddenLastFrame(const NodeHistory& h) const { return frame_ > 0 && h.lastQueryFrame == frame_ && !h.lastVisible; }
 
     /// One frame's borrowed state, passed through every stage (cull_frame.hpp).
     struct Frame;
