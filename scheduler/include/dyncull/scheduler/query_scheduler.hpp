@@ -273,12 +273,12 @@ public:
     /// (cleared at the start of each frame). The caller owns the vector; nullptr stops.
     void setTrace(std::vector<NodeTrace>* trace) { trace_ = trace; }
     std::uint32_t frameIndex() const { return frame_; }
-    /// True if the newest frame tested `ref` (a live node of `objects`) and found it hidden:
-    /// it lay in the frustum, reached by the traversal, behind what was drawn. A node never
-    /// reached (its subtree culled whole, or outside the frustum) or drawn gives false.
     /// The visibility record of `ref` (a live node of `objects`), or nullptr if the culler
     /// has none for the object as it is now. Valid until the next cullFrame.
     const NodeHistory* history(NodeRef ref, const SceneObjects& objects) const { return history_.find(ref, objects); }
+    /// True if the newest frame tested `ref` (a live node of `objects`) and found it hidden:
+    /// it lay in the frustum, reached by the traversal, behind what was drawn. A node never
+    /// reached (its subtree culled whole, or outside the frustum) or drawn gives false.
     bool testedHiddenLastFrame(NodeRef ref, const SceneObjects& objects) const {
         const NodeHistory* h = history_.find(ref, objects);
         return h && testedHiddenLastFrame(*h);
