@@ -17,6 +17,7 @@
 #include "dyncull/demos/demo_scene.hpp"
 #include "dyncull/demos/progress_bar.hpp"
 #include "dyncull/loaders/ply_stream.hpp"
+#include "dyncull/objects/file_extension.hpp"
 #include "dyncull/streaming/out_of_core_subdivision.hpp"
 #include "scene_options.hpp"
 
@@ -40,11 +41,7 @@ bool resetPeakRss() {
 
 double mb(std::size_t bytes) { return static_cast<double>(bytes) / (1024.0 * 1024.0); }
 
-bool hasExtension(const std::string& path, const char* ext) {
-    std::string e = std::filesystem::path(path).extension().string();
-    for (char& c : e) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return e == ext;
-}
+bool hasExtension(const std::string& path, const char* ext) { return lowercaseExtension(path) == ext; }
 
 /// Out of core: a PLY file is streamed from disk; other sources (built-in scenes, OBJ,
 /// glTF, directories) are loaded whole first, then streamed from memory.

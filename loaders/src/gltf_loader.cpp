@@ -17,6 +17,7 @@
 #include <tiny_gltf.h>
 
 #include "dyncull/loaders/loaders.hpp"
+#include "dyncull/objects/file_extension.hpp"
 #include "dyncull/objects/transform.hpp"
 #include "loader_common.hpp"
 
@@ -434,9 +435,7 @@ Expected<Scene> loadGltfImpl(const std::filesystem::path& path) {
     if (Status s = detail::readWholeFile(path, bytes); !s) return s.error();
     if (bytes.size() > std::numeric_limits<unsigned int>::max())
         return detail::fileError(path, "larger than 4 GiB, which tinygltf cannot address");
-    std::string ext = path.extension().string();
-    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    const bool binary = ext == ".glb";
+    const bool binary = lowercaseExtension(path) == ".glb";
     std::string_view json = bytes;
     if (binary)
         if (auto f = checkGlb(bytes, json)) return detail::fileError(path, f->what);

@@ -1,15 +1,14 @@
 // loadScene: picks the loader from the file extension.
-#include <cctype>
 #include <string>
 
 #include "dyncull/loaders/loaders.hpp"
+#include "dyncull/objects/file_extension.hpp"
 #include "loader_common.hpp"
 
 namespace dyncull {
 
 Expected<Scene> loadScene(const std::filesystem::path& path) {
-    std::string ext = path.extension().string();
-    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    const std::string ext = lowercaseExtension(path);
     if (ext == ".ply") return loadPly(path);
     if (ext == ".obj") return loadObj(path);
     if (ext == ".gltf" || ext == ".glb") return loadGltf(path);

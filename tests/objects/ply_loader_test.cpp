@@ -485,7 +485,9 @@ TEST(PlyWriter, WritesWhatTheLoaderReadsBack) {
         const Mesh& m = scene->meshes[0];
         EXPECT_EQ(m.positions, p);
         EXPECT_EQ(m.indices, (std::vector<std::uint32_t>{0, 1, 2, 0, 2, 3}));
-        if (normals) EXPECT_EQ(m.normals[3], glm::vec3(0, 0, 1));  // the file's, normalised
+        if (normals) {
+            EXPECT_EQ(m.normals[3], glm::vec3(0, 0, 1));  // the file's, normalised
+        }
     }
 }
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "dyncull/loaders/loaders.hpp"
+#include "dyncull/objects/file_extension.hpp"
 #include "objects/test_files.hpp"
 
 namespace dyncull {
@@ -24,6 +25,18 @@ TEST(SceneLoader, DispatchIsCaseInsensitive) {
     auto obj = loadScene(dir.write("d.OBJ", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"));
     ASSERT_TRUE(obj.ok()) << obj.error().message;
     EXPECT_EQ(obj->uniqueTriangleCount(), 1u);
+}
+
+// The one extension convention: the last dot's suffix, ASCII lowercase; none for a name
+// without a dot or a dot file ("" then: the loaders say "no file extension").
+TEST(SceneLoader, ExtensionsAreComparedInLowercase) {
+    EXPECT_EQ(lowercaseExtension("Bunny.PLY"), ".ply");
+    EXPECT_EQ(lowercaseExtension("dir.GLTF/Model.GlB"), ".glb");
+    EXPECT_EQ(lowercaseExtension("campus.tar.DNODES"), ".dnodes");
+    EXPECT_EQ(lowercaseExtension("noextension"), "");
+    EXPECT_EQ(lowercaseExtension(".hidden"), "");
+    EXPECT_EQ(lowercaseExtension("trailing."), ".");
+    EXPECT_EQ(lowercaseExtension("caf\xc3\xa9.\xc3\x89"), ".\xc3\x89") << "bytes outside ASCII are kept as they are";
 }
 
 TEST(SceneLoader, UnknownExtension) {

@@ -1,7 +1,6 @@
 // Test helpers: a per-test temporary directory and small file writers.
 #pragma once
 
-#include <cctype>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -14,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "dyncull/objects/error.hpp"
+#include "dyncull/objects/file_extension.hpp"
 #include "dyncull/objects/scene.hpp"
 
 namespace dyncull::test {
@@ -49,8 +49,7 @@ public:
     static void exportFuzzSeed(const std::string& name, const std::string& bytes) {
         const char* seeds = std::getenv("DYNCULL_FUZZ_SEEDS");
         if (!seeds || !*seeds) return;
-        std::string ext = std::filesystem::path(name).extension().string();
-        for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+        const std::string ext = lowercaseExtension(name);
         if (ext.size() < 2) return;
         const auto dir = std::filesystem::path(seeds) / ext.substr(1);
         std::filesystem::create_directories(dir);

@@ -6,6 +6,7 @@
 
 #include "dyncull/demos/demo_scene.hpp"
 #include "dyncull/loaders/loaders.hpp"
+#include "dyncull/objects/file_extension.hpp"
 #include "dyncull/objects/motion.hpp"
 #include "generators.hpp"
 
@@ -15,8 +16,7 @@ namespace {
 namespace fs = std::filesystem;
 
 bool isPart(const fs::path& p) {
-    std::string ext = p.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    const std::string ext = lowercaseExtension(p);
     return ext == ".ply" || ext == ".obj";
 }
 
