@@ -206,16 +206,26 @@ bool applyQueriesSetting(const std::string& part, ModeSpec& m) {
 
 }  // namespace
 
+namespace {
+// The families' names: one per approximation, shared by named modes and sweeps.
+constexpr const char* kErrorBudgetFamily = "error budget";
+constexpr const char* kThresholdFamily = "sample threshold";
+constexpr const char* kSmallFeatureFamily = "small features";
+constexpr const char* kLatencyFamily = "latency";
+}  // namespace
+
 std::string approximationFamily(const ModeSpec& m) {
     if (m.oracle) return {};
     const SchedulerApproximations& a = m.scheduler.approx;
     std::string family;
     auto add = [&](const char* what) { family += (family.empty() ? "" : " + ") + std::string(what); };
-    if (a.errorBudgetPercent > 0)
-        add(a.budgetEarlySet ? "error budget, early set" : a.budgetRecount ? "error budget, recount" : "error budget");
-    if (m.queries.visiblePixelThreshold > 0) add("sample threshold");
-    if (a.smallFeaturePixels > 0) add("small features");
-    if (a.useLastFrameResults) add("latency");
+    if (a.errorBudgetPercent > 0) {
+        add(kErrorBudgetFamily);
+        family += a.budgetEarlySet ? ", early set" : a.budgetRecount ? ", recount" : "";
+    }
+    if (m.queries.visiblePixelThreshold > 0) add(kThresholdFamily);
+    if (a.smallFeaturePixels > 0) add(kSmallFeatureFamily);
+    if (a.useLastFrameResults) add(kLatencyFamily);
     return family;
 }
 
@@ -322,9 +332,10 @@ Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec) {
             if (o.name == m.name) return Error{"--param: value " + text + " given twice"};
         // Every value of a parameter is one family (its 0 the curve's conservative end), named
         // as approximationFamily names the approximation the parameter sets.
-        m.family = param == "error-budget"      ? "error budget"
-                   : param == "pixel-threshold" ? "sample threshold"
-                   : param == "small-feature"   ? "small features"
+        m.family = param == "error-budget"      ? kErrorBudgetFamily
+                   : param == "pixel-threshold" ? kThresholdFamily
+                   : param == "small-feature"   ? kSmallFeatureFamily
+                   : param == "latency"         ? kLatencyFamily
                                                 : param;
         out.push_back(std::move(m));
     }

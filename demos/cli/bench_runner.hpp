@@ -69,12 +69,10 @@ Expected<std::vector<ModeSpec>> modesFromList(const std::string& list);
 /// Names understood by modeFromName (N stands for a number), for help texts.
 std::string modeNamesHelp();
 
-/// Sweep of one parameter of `queries`: "NAME=v1,v2,..." with NAME one of pixel-threshold,
-/// max-skip, skip-per-visible, small-feature, max-in-flight, tile-size, auto-saving
-/// (percent; queries with the auto volume). One mode per value, named "NAME=v". Error names
-/// the bad parameter or value.
-/// `sweep --param NAME=v1,v2,...` (given once per family): one mode per value, named
-/// "NAME=v", its family set. Error for an unknown name, a bad value, or a value twice.
+/// One `sweep --param` (given once per family): "NAME=v1,v2,..." with NAME one of
+/// sweepParamsHelp()'s parameters of `queries`, or error-budget (of `full`). One mode per
+/// value, named "NAME=v", all of one family. Error names the bad parameter or value, or a
+/// value given twice.
 Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec);
 std::string sweepParamsHelp();
 

@@ -41,14 +41,12 @@ bool resetPeakRss() {
 
 double mb(std::size_t bytes) { return static_cast<double>(bytes) / (1024.0 * 1024.0); }
 
-bool hasExtension(const std::string& path, const char* ext) { return lowercaseExtension(path) == ext; }
-
 /// Out of core: a PLY file is streamed from disk; other sources (built-in scenes, OBJ,
 /// glTF, directories) are loaded whole first, then streamed from memory.
 void runSubdivideOutOfCore(const SubdivideCommandOptions& o) {
     auto sp = toSubdivisionParams(o.sceneOptions.subdivide);
     if (!sp) fail(sp.error().message);
-    if (!hasExtension(o.out, ".dnodes")) fail("--out " + o.out + ": a streamed model is named BASE.dnodes (with BASE.dgeom beside it)");
+    if (lowercaseExtension(o.out) != ".dnodes") fail("--out " + o.out + ": a streamed model is named BASE.dnodes (with BASE.dgeom beside it)");
     OutOfCoreParams params;
     params.subdivision = *sp;
     params.memoryBytes = std::size_t{o.memoryMb} << 20;
@@ -56,7 +54,7 @@ void runSubdivideOutOfCore(const SubdivideCommandOptions& o) {
     Stopwatch sw;
     std::optional<StaticSoup> soup;
     MeshStreamSource source;
-    if (hasExtension(o.source, ".ply")) {
+    if (lowercaseExtension(o.source) == ".ply") {
         params.source = o.source;
         source = [&](MeshStreamSink& sink) { return streamPly(o.source, sink); };
     } else {

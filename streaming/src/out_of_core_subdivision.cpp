@@ -29,10 +29,11 @@ constexpr std::size_t kIoBuffer = std::size_t{1} << 20;
 /// 1/1024 of the node's centroid extent, which balances the halves to well within a percent.
 constexpr int kBins = 1024;
 /// Memory of an in-memory subtree per triangle, an estimate with room to spare (the
-/// preprocessing runs in docs/BENCHMARKS.md peak well under their budgets): the records (48), vertex ids sorted for the mesh (12 + 4), the mesh
-/// (indices 12, positions and normals 24 per vertex, up to 3 vertices per triangle), the
-/// subdivision's work arrays (SubdivisionStats::workBytes, about 60) and the leaf meshes
-/// with meshoptimizer's scratch (about the mesh again).
+/// preprocessing runs in docs/BENCHMARKS.md peak well under their budgets): the records
+/// (48), vertex ids sorted for the mesh (12 + 4), the mesh (indices 12, positions and
+/// normals 24 per vertex, up to 3 vertices per triangle), the subdivision's work arrays
+/// (SubdivisionStats::workBytes, about 60) and the leaf meshes with meshoptimizer's
+/// scratch (about the mesh again).
 constexpr std::size_t kSubtreeBytesPerTriangle = 400;
 
 double msSince(std::chrono::steady_clock::time_point t) {
