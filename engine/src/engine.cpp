@@ -47,6 +47,7 @@ struct Engine::Sink final : PartSink {
         record(part, n.firstIndex, n.indexCount);
         render(part, ranges);
     }
+    void drawMorePartRanges(NodeRef part, std::span<const IndexRange> ranges) override { render(part, ranges); }
     // The part renderer's draw of `ranges` of `part`, marked while marking.
     void render(NodeRef part, std::span<const IndexRange> ranges) {
         const SceneObjects& objs = e.objects_;

@@ -6,70 +6,110 @@
 // ../shared/notes/batched-occlusion-tests.md). The finer level of "model only what a scene
 // requires": the BSP's parts stay the unit of queries and history, clusters are tested
 // only through these cheap paths, and only where the measured savings pay for the tests.
+// With cluster history (cluster_history.cpp) a draw takes only one pass's share of a part's
+// clusters: in the early pass those that showed last frame, in the late pass the others.
+
+#include <algorithm>
 
 #include "cull_frame.hpp"
 
 namespace dyncull {
 
+namespace {
+/// True if cluster `c` of an object with `matrix` shows nothing: outside the frustum (if
+/// `frustum`: its part crosses it), or behind the depth pyramid (if `pyramid`). A cluster
+/// the eye is inside of or that reaches the near plane is visible; one off screen is not.
+bool clusterHidden(const QueryScheduler::Frame& f, const DepthPyramid* pyramid, const glm::mat4& matrix, const LeafCluster& c,
+                   bool frustum) {
+    const Aabb world = transformAabb(matrix, c.box);
+    if (frustum && f.frustum().outside(world)) return true;
+    if (!pyramid || world.contains(f.camera().position)) return false;
+    ScreenRect rect;
+    float nearest = 1.0f;
+    if (!f.screen.volumeDepth(QueryVolume::fromTransformedBox(matrix, c.box), rect, nearest)) return false;
+    return rect.empty() || pyramid->occluded(rect, nearest);
+}
 
-bool QueryScheduler::cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, const LocalBspNode& n) {
+bool bitSet(std::span<const std::uint64_t> bits, std::uint32_t i) { return (bits[i >> 6] >> (i & 63)) & 1u; }
+}  // namespace
+
+bool QueryScheduler::cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, const LocalBspNode& n, ClusterPass pass) {
     clusterRanges_.clear();
+    lastDeferred_ = 0;
     if (!params_.features.useClusters || ref.isSceneNode() || !f.sink.drawsRanges() || !model.clusters.builtFor(model.nodes.size()))
         return false;
     const std::span<const LeafCluster> clusters = model.clusters.ofSubtree(ref.node, n.subtreeSize);
     if (clusters.empty()) return false;
     const SceneObjects& objs = f.objects;
+    if (f.recordClusterBits && pass != ClusterPass::Deferred) clusterParts_.push_back(ref);  // its bits are written at the frame's end
     // Which tests can cull anything here: cones only where back faces are culled, the
     // frustum only for a part crossing it, the pyramid only after the early pass.
     const bool cones = model.faces == FaceMode::CullBack && f.sink.cullsBackFaces();
     const bool frustum = f.frustum().classify(f.tree.worldBox(ref)) != Frustum::Side::Inside;
     const bool pyramid = f.clusterPyramid;
-    if (!cones && !frustum && !pyramid) return false;
-    if (!cones && !pyramid && clusters.size() == 1) return false;  // the part's own frustum test said it all
-
-    // The cost model: a model's clusters are tested while the drawing they were measured
-    // to save (its rate of culled triangles) exceeds the tests' cost; one part in eight
-    // is tested regardless, so the rate stays measured.
+    // With cluster history the early pass draws the clusters that showed last frame and
+    // the late pass the others: a split no cost model may turn off.
+    const bool split = pass != ClusterPass::All;
     const ModelId modelId = objs.modelOf(ref.object);
     if (clusterCulledRate_.size() <= modelId) clusterCulledRate_.resize(modelId + 1, 0.5);
     double& rate = clusterCulledRate_[modelId];
     const std::uint32_t triangles = n.indexCount / 3;
-    if (params_.features.useCostModel && !exploring(ref) &&
-        rate * triangles * params_.tuning.costs.drawNsPerTriangle < double(clusters.size()) * params_.tuning.costs.clusterTestNs)
-        return false;
+    if (!split) {
+        if (!cones && !frustum && !pyramid) return false;
+        if (!cones && !pyramid && clusters.size() == 1) return false;  // the part's own frustum test said it all
+        // The cost model: a model's clusters are tested while the drawing they were
+        // measured to save (its rate of culled triangles) exceeds the tests' cost; one
+        // part in eight is tested regardless, so the rate stays measured.
+        if (params_.features.useCostModel && !exploring(ref) &&
+            rate * triangles * params_.tuning.costs.drawNsPerTriangle < double(clusters.size()) * params_.tuning.costs.clusterTestNs)
+            return false;
+    }
 
     const auto t0 = SchedulerClock::now();
     const glm::mat4& matrix = objs.matrix(ref.object);
+    const std::span<const std::uint64_t> shown = split ? history_.clusterBits(ref.object, objs) : std::span<const std::uint64_t>{};
+    const std::uint32_t firstCluster = model.clusters.nodeFirst[ref.node];
     // The eye in the object's space (affine maps keep which side of a plane a point is on,
     // mirroring included, as the rasteriser's facing follows the transformed winding).
     const glm::dmat4 toObject = glm::inverse(glm::dmat4(matrix));
     const bool ortho = f.camera().orthographic();
     const glm::dvec3 eye = glm::dvec3(toObject * glm::dvec4(glm::dvec3(f.camera().position), 1.0));
     const glm::dvec3 along = glm::dvec3(toObject * glm::dvec4(glm::dvec3(f.camera().forward()), 0.0));
-    std::uint64_t culledTriangles = 0, gapTriangles = 0;
-    std::uint32_t culledClusters = 0, gapClusters = 0;
-    for (const LeafCluster& c : clusters) {
-        bool culled = cones && (ortho ? c.backFacingAlong(along) : c.backFacingFrom(eye));
-        if (!culled && (frustum || pyramid)) {
-            const Aabb world = transformAabb(matrix, c.box);
-            culled = frustum && f.frustum().outside(world);
-            if (!culled && pyramid && !world.contains(f.camera().position)) {
-                ScreenRect rect;
-                float nearest = 1.0f;
-                // A cluster reaching the near plane is visible; one off screen shows nothing.
-                if (f.screen.volumeDepth(QueryVolume::fromTransformedBox(matrix, c.box), rect, nearest))
-                    culled = rect.empty() || pyramid_.occluded(rect, nearest);
-            }
+    std::uint64_t culledTriangles = 0, gapTriangles = 0, deferredTriangles = 0, drawnTriangles = 0;
+    std::uint32_t culledClusters = 0, gapClusters = 0, deferred = 0, drawn = 0;
+    // Split passes never merge gaps: what their tests culled, apart from the other pass's clusters.
+    std::uint64_t splitCulledTriangles = 0;
+    std::uint32_t splitCulled = 0;
+    for (std::uint32_t i = 0; i < clusters.size(); ++i) {
+        const LeafCluster& c = clusters[i];
+        // Deferred: drawn early already. Early: hidden last frame, left to the late pass
+        // if it faces the eye and is in the frustum.
+        const bool otherPass = split && bitSet(shown, firstCluster + i) == (pass == ClusterPass::Deferred);
+        const bool drawnEarly = pass == ClusterPass::Deferred && otherPass;
+        bool culled = !drawnEarly && cones && (ortho ? c.backFacingAlong(along) : c.backFacingFrom(eye));
+        if (!drawnEarly && !culled && (frustum || pyramid)) culled = clusterHidden(f, pyramid ? &pyramid_ : nullptr, matrix, c, frustum);
+        if (culled && split) {
+            ++splitCulled;
+            splitCulledTriangles += c.indexCount / 3;
+        }
+        culled |= drawnEarly;
+        if (!culled && otherPass) {
+            ++deferred;
+            deferredTriangles += c.indexCount / 3;
+            culled = true;
         }
         if (culled) {
             ++gapClusters;
             gapTriangles += c.indexCount / 3;
             continue;
         }
+        ++drawn;
+        drawnTriangles += c.indexCount / 3;
         // A gap of culled clusters between two drawn ones costs one more range of the
-        // multi-draw: skipped only where it saves more drawing than a range costs.
+        // multi-draw: skipped only where it saves more drawing than a range costs, and
+        // always when it holds clusters the other pass draws.
         IndexRange* last = clusterRanges_.empty() ? nullptr : &clusterRanges_.back();
-        if (last && double(gapTriangles) * params_.tuning.costs.drawNsPerTriangle < params_.tuning.costs.drawNsPerRange) {
+        if (last && !split && double(gapTriangles) * params_.tuning.costs.drawNsPerTriangle < params_.tuning.costs.drawNsPerRange) {
             last->indexCount = c.firstIndex + c.indexCount - last->firstIndex;
         } else {
             clusterRanges_.push_back({c.firstIndex, c.indexCount});
@@ -82,10 +122,23 @@ bool QueryScheduler::cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, 
     culledClusters += gapClusters;  // after the last drawn one: costs no range
     culledTriangles += gapTriangles;
     f.stats.clusterTests += static_cast<std::uint32_t>(clusters.size());
-    f.stats.clustersCulled += culledClusters;
-    f.stats.clusterTrianglesCulled += culledTriangles;
+    lastDeferred_ = deferred;
+    if (pass == ClusterPass::Early) {
+        f.stats.clustersDeferred += deferred;
+        deferredTriangles_ += deferredTriangles;
+    } else if (pass == ClusterPass::Deferred) {
+        f.stats.deferredClustersDrawn += drawn;
+        deferredTriangles_ -= std::min(deferredTriangles_, drawnTriangles);
+    }
+    if (split) {
+        f.stats.clustersCulled += splitCulled;
+        f.stats.clusterTrianglesCulled += splitCulledTriangles;
+    } else {
+        f.stats.clustersCulled += culledClusters;
+        f.stats.clusterTrianglesCulled += culledTriangles;
+        rate += 0.02 * (double(culledTriangles) / double(triangles > 0 ? triangles : 1) - rate);
+    }
     f.stats.clusterMs += msSince(t0);
-    rate += 0.02 * (double(culledTriangles) / double(triangles > 0 ? triangles : 1) - rate);
     return true;
 }
 

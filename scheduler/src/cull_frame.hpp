@@ -34,6 +34,10 @@ struct QueryScheduler::Frame {
     bool marking = false;
     /// The depth pyramid holds this frame's early depth: cluster culling may test against it.
     bool clusterPyramid = false;
+    /// TwoPhase with cluster history (SchedulerFeatures::useClusterHistory): the early pass
+    /// draws only the clusters that showed last frame (their bits were recorded then), and
+    /// this frame records which of its drawn parts' clusters show at its end.
+    bool useClusterBits = false, recordClusterBits = false;
 
     const Camera& camera() const { return view.camera; }
     const Frustum& frustum() const { return view.frustum; }

@@ -196,11 +196,18 @@ QueryVolume objectNodeVolume(const SceneObjects& objs, NodeRef ref, VolumeChoice
     return QueryVolume::fromNodeVolume(m, model.volumes, v);
 }
 
-void QueryScheduler::drawNode(Frame& f, NodeRef ref, bool untested) {
+void QueryScheduler::drawNode(Frame& f, NodeRef ref, bool untested, ClusterPass pass) {
     const SceneObjects& objs = f.objects;
     const LocalBsp& model = objs.model(objs.modelOf(ref.object));
     const LocalBspNode& n = model.nodes[ref.node];
-    const bool clustered = cullClusters(f, ref, model, n);
+    const bool clustered = cullClusters(f, ref, model, n, pass);
+    if (lastDeferred_ > 0) {
+        // The late pass decides on the rest of its clusters, and on its trace entry if
+        // none is drawn now.
+        const bool traced = f.trace && !f.trace->empty() && f.trace->back().ref == ref;
+        deferredParts_.push_back({ref, !clusterRanges_.empty(), traced ? static_cast<std::uint32_t>(f.trace->size() - 1) : kInvalidIndex});
+        if (clusterRanges_.empty()) return;
+    }
     if (clustered && clusterRanges_.empty()) {
         // No cluster of it can show a pixel: its decision, traced just before, becomes this.
         if (f.trace) {

@@ -73,6 +73,31 @@ ScreenRect ScreenProjection::pixelRect(const glm::dvec2& lo, const glm::dvec2& h
             clampi(std::ceil((hi.x + 1.0) * fx) + 1.0, view_.width), clampi(std::ceil((hi.y + 1.0) * fy) + 1.0, view_.height)};
 }
 
+glm::mat4 ScreenProjection::clipMatrixOf(const glm::mat4& matrix) const {
+    glm::dmat4 relative(matrix);
+    relative[3] -= glm::dvec4(glm::dvec3(view_.camera.position), 0.0);  // world minus the eye
+    return glm::mat4(view_.viewProjRelative * relative);
+}
+
+bool ScreenProjection::roughBoxDepth(const glm::mat4& objectToClip, const Aabb& local, ScreenRect& rect, float& nearestDepth) const {
+    glm::vec2 lo(1e30f), hi(-1e30f);
+    float nearest = 0.0f;
+    for (int i = 0; i < 8; ++i) {
+        const glm::vec4 corner((i & 1) ? local.max.x : local.min.x, (i & 2) ? local.max.y : local.min.y,
+                               (i & 4) ? local.max.z : local.min.z, 1.0f);
+        const glm::vec4 clip = objectToClip * corner;
+        // Reversed Z: window depth 1 at the near plane, above it in front of it.
+        if (clip.w <= 0.0f || clip.z >= clip.w) return false;
+        const glm::vec2 ndc = glm::vec2(clip) / clip.w;
+        lo = glm::min(lo, ndc);
+        hi = glm::max(hi, ndc);
+        nearest = std::max(nearest, clip.z / clip.w);
+    }
+    rect = pixelRect(glm::dvec2(lo), glm::dvec2(hi));
+    nearestDepth = nearest;
+    return true;
+}
+
 bool ScreenProjection::volumeDepth(const QueryVolume& volume, ScreenRect& rect, float& nearestDepth) const {
     // The volume grown by the rounding of its float vertices, projected in double; any
     // point within the near-plane margin makes it "crossing" (visible), as in projectRect.

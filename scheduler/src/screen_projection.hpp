@@ -28,6 +28,15 @@ public:
     /// of its points'), the volume grown by its vertices' rounding first; false if it
     /// reaches the near plane (then it is simply visible).
     bool volumeDepth(const QueryVolume& volume, ScreenRect& rect, float& nearestDepth) const;
+    /// A guess, for choices that need no guarantee (cluster history's record of what
+    /// showed): the rectangle and nearest window depth of box `local` under
+    /// `objectToClip` (object space to clip space, camera-relative: clipMatrixOf), its 8
+    /// corners projected in float with no rounding margins; false if a corner lies behind
+    /// the near plane.
+    bool roughBoxDepth(const glm::mat4& objectToClip, const Aabb& local, ScreenRect& rect, float& nearestDepth) const;
+    /// Object space to clip space for an object whose object-to-world matrix is `matrix`,
+    /// through the camera-relative view-projection (in double, then float).
+    glm::mat4 clipMatrixOf(const glm::mat4& matrix) const;
     /// Normalised-device bounds [lo, hi] as viewport pixels, rounded outwards, padded by one.
     ScreenRect pixelRect(const glm::dvec2& lo, const glm::dvec2& hi) const;
 

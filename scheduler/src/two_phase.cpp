@@ -9,7 +9,11 @@
 //     raster test against the early depth (NVIDIA's gl_occlusion_culling "temporal current
 //     frame" scheme) and the visible ones drawn; then the parts drawn are tested against
 //     the final depth, and those visible there are next frame's early set.
-// Where the sink draws the parts itself, step 4 goes one level finer: the parts whose
+// Where the sink draws clusters, the early set is kept per cluster: a part drawn early is
+// drawn as only the clusters whose boxes showed in the final depth of the frame it was last
+// drawn in, and its other clusters are tested against the pyramid in the late pass
+// (cluster_history.cpp).
+// Where the sink draws the parts itself, step 4 can go one level finer: the parts whose
 // volumes passed are tested on their own triangles before they are drawn, and each draw
 // marks whether it showed a sample, so the early set is the parts whose triangles, not
 // volumes, were visible (the test on the geometry that the volume bound in
@@ -37,14 +41,27 @@ void QueryScheduler::runTwoPhase(Frame& f) {
         f.marking = true;
     }
 
+    // Unless the cost model turns this frame's tests off, its early parts draw only the
+    // clusters that showed last frame (cluster history).
+    const bool testing = !params_.features.useCostModel || savedNs_ > params_.tuning.costs.depthReadNs ||
+                         f.index - lastTestedFrame_ >= params_.tuning.costs.probeFrames;
+    deferredParts_.clear();
+    clusterParts_.clear();
+    deferredTriangles_ = 0;
+    const bool clusterHistory =
+        testing && params_.features.useClusterHistory && params_.features.useClusters && !triangles && f.sink.drawsRanges();
+    // Its own cost model: the bits are recorded while what they saved the frame after
+    // (deferred triangles the late pass did not draw) exceeds what recording them cost, and
+    // every probeFrames frames to measure that again.
+    f.useClusterBits = clusterHistory && lastClusterRecordFrame_ + 1 == f.index;
+    f.recordClusterBits = clusterHistory && (!params_.features.useCostModel || clusterBitsSavedNs_ > clusterRecordNs_ ||
+                                             f.index - lastClusterRecordFrame_ >= params_.tuning.costs.probeFrames);
+
     // 1. Early pass.
     const bool drewEarly = drawEarlySet(f);
 
-    // 2. The early pass's depth, unless the cost model turned this frame's tests off. A
-    // backend that cannot read depth leaves the pyramid unbuilt, and an unbuilt pyramid
-    // calls nothing occluded.
-    const bool testing = !params_.features.useCostModel || savedNs_ > params_.tuning.costs.depthReadNs ||
-                         f.index - lastTestedFrame_ >= params_.tuning.costs.probeFrames;
+    // 2. The early pass's depth, unless this frame does not test. A backend that cannot
+    // read depth leaves the pyramid unbuilt, and an unbuilt pyramid calls nothing occluded.
     culledTriangles_ = 0;
     bool haveDepth = false;
     if (testing) {
@@ -64,6 +81,10 @@ void QueryScheduler::runTwoPhase(Frame& f) {
         active_.push_back(root);
         lateTraversal(f, testing, haveDepth, triangles);
     }
+    // The early parts' clusters that were hidden last frame, where the pyramid lets them
+    // through: drawn before the raster tests, whose depth they make nearer.
+    if (!deferredParts_.empty()) drawDeferredClusters(f);
+    if (f.useClusterBits) clusterBitsSavedNs_ = double(deferredTriangles_) * params_.tuning.costs.drawNsPerTriangle;
 
     // 4. The batched raster test, exact per pixel against the early pass's depth, for the
     // parts the pyramid let through; then every part drawn after a test (early, or late
@@ -73,6 +94,7 @@ void QueryScheduler::runTwoPhase(Frame& f) {
     if (!triangleTests_.empty()) testTriangles(f);
     if (triangles) readDrawMarks(f);
     if (!refresh_.empty()) testRefresh(f);
+    if (f.recordClusterBits && !clusterParts_.empty()) recordClusterVisibility(f);
     // A frame with no early depth (the first, or after everything turned hidden) had
     // nothing to test the pyramid against, so only the final-depth tests measured what
     // testing saves; without them the frame says nothing and the estimate stands.
@@ -97,7 +119,7 @@ bool QueryScheduler::drawEarlySet(Frame& f) {
         }
         if (h.lastVisible && h.lastVisibleFrame + 1 == f.index) {
             f.note(ref, NodeState::VisibleHistory);  // drawn untested
-            drawNode(f, ref, false);
+            drawNode(f, ref, false, f.useClusterBits ? ClusterPass::Early : ClusterPass::All);
             h.lastTouchedFrame = f.index;
         }
     }

@@ -8,34 +8,52 @@
 
 namespace dyncull {
 
-NodeHistory& VisibilityHistory::at(NodeRef ref, const SceneObjects& objects) {
-    if (ref.isSceneNode()) {
-        if (ref.node >= scene_.size()) scene_.resize(ref.node + 1);
-        return scene_[ref.node];
-    }
-    const std::uint32_t slot = ref.object;
+namespace {
+std::size_t clusterWordsOf(const LocalBsp& model) {
+    return model.clusters.builtFor(model.nodes.size()) ? (model.clusters.clusters.size() + 63) / 64 : 0;
+}
+}  // namespace
+
+void VisibilityHistory::ensureBlock(std::uint32_t slot, const SceneObjects& objects) {
     if (slot >= objectBase_.size()) {
         objectBase_.resize(slot + 1, kInvalidIndex);
+        objectClusterBase_.resize(slot + 1, 0);
         objectGen_.resize(slot + 1, 0);
         objectModel_.resize(slot + 1, kInvalidIndex);
     }
     const std::uint32_t gen = objects.handle(slot).generation;
     const ModelId model = objects.modelOf(slot);
-    const std::size_t nodes = objects.model(model).nodes.size();
+    const LocalBsp& m = objects.model(model);
     if (objectBase_[slot] == kInvalidIndex || objectModel_[slot] != model) {
         // New block; a slot whose model changed leaks its old block until clear(), which
         // only happens when objects are re-created with another model (rare).
         objectBase_[slot] = static_cast<std::uint32_t>(objectNodes_.size());
-        objectNodes_.resize(objectNodes_.size() + nodes);
+        objectNodes_.resize(objectNodes_.size() + m.nodes.size());
+        objectClusterBase_[slot] = static_cast<std::uint32_t>(clusterWords_.size());
+        clusterWords_.resize(clusterWords_.size() + clusterWordsOf(m), 0);
         objectModel_[slot] = model;
         objectGen_[slot] = gen;
     } else if (objectGen_[slot] != gen) {
         // Slot reused by a new object of the same model: its history means nothing now.
-        std::fill_n(objectNodes_.begin() + objectBase_[slot], nodes, NodeHistory{});
+        std::fill_n(objectNodes_.begin() + objectBase_[slot], m.nodes.size(), NodeHistory{});
+        std::fill_n(clusterWords_.begin() + objectClusterBase_[slot], clusterWordsOf(m), 0);
         objectGen_[slot] = gen;
     }
-    assert(ref.node < nodes && "a node of the object's current model");
-    return objectNodes_[objectBase_[slot] + ref.node];
+}
+
+NodeHistory& VisibilityHistory::at(NodeRef ref, const SceneObjects& objects) {
+    if (ref.isSceneNode()) {
+        if (ref.node >= scene_.size()) scene_.resize(ref.node + 1);
+        return scene_[ref.node];
+    }
+    ensureBlock(ref.object, objects);
+    assert(ref.node < objects.model(objects.modelOf(ref.object)).nodes.size() && "a node of the object's current model");
+    return objectNodes_[objectBase_[ref.object] + ref.node];
+}
+
+std::span<std::uint64_t> VisibilityHistory::clusterBits(std::uint32_t object, const SceneObjects& objects) {
+    ensureBlock(object, objects);
+    return {clusterWords_.data() + objectClusterBase_[object], clusterWordsOf(objects.model(objects.modelOf(object)))};
 }
 
 const NodeHistory* VisibilityHistory::find(NodeRef ref, const SceneObjects& objects) const {
@@ -50,7 +68,9 @@ const NodeHistory* VisibilityHistory::find(NodeRef ref, const SceneObjects& obje
 void VisibilityHistory::clear() {
     scene_.clear();
     objectNodes_.clear();
+    clusterWords_.clear();
     objectBase_.clear();
+    objectClusterBase_.clear();
     objectGen_.clear();
     objectModel_.clear();
 }
@@ -82,8 +102,9 @@ std::uint32_t VisibilityHistory::postponement(NodeRef ref, const NodeHistory& h,
 }
 
 std::size_t VisibilityHistory::memoryBytes() const {
-    return (scene_.capacity() + objectNodes_.capacity()) * sizeof(NodeHistory) +
-           (objectBase_.capacity() + objectGen_.capacity() + objectModel_.capacity()) * sizeof(std::uint32_t);
+    return (scene_.capacity() + objectNodes_.capacity()) * sizeof(NodeHistory) + clusterWords_.capacity() * sizeof(std::uint64_t) +
+           (objectBase_.capacity() + objectClusterBase_.capacity() + objectGen_.capacity() + objectModel_.capacity()) *
+               sizeof(std::uint32_t);
 }
 
 }  // namespace dyncull

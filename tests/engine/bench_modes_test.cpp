@@ -30,6 +30,9 @@ TEST(BenchModes, AblationsOfFullAndTheirVolumes) {
     EXPECT_TRUE(modeFromName("full-tri")->scheduler.features.useTriangleTests);
     EXPECT_TRUE(modeFromName("full")->scheduler.features.useClusters);
     EXPECT_FALSE(modeFromName("full-noclusters")->scheduler.features.useClusters);
+    EXPECT_TRUE(modeFromName("full")->scheduler.features.useClusterHistory);
+    EXPECT_FALSE(modeFromName("full-noclusterhist")->scheduler.features.useClusterHistory);
+    EXPECT_TRUE(modeFromName("full-noclusterhist")->scheduler.features.useClusters);
     EXPECT_TRUE(modeFromName("vfc")->scheduler.features.useClusters);
     EXPECT_FALSE(modeFromName("vfc-noclusters")->scheduler.features.useClusters);
     EXPECT_EQ(modeFromName("vfc-noclusters")->scheduler.mode, CullMode::Vfc);

@@ -1074,3 +1074,46 @@ TEST(TwoPhaseCosts, AFrameWithoutEarlyDepthDoesNotTurnTheTestsOff) {
     EXPECT_EQ(backend.reads, 3);
     EXPECT_TRUE(third.drawn.empty());
 }
+
+TEST(VisibilityHistory, ClusterBitsFollowTheObjectInTheirSlot) {
+    // One bit per cluster of the object's model, cleared when created; kept for the same
+    // object; cleared again when its slot is reused (generation) or its model changes.
+    LocalBspParams fine;
+    fine.maxLeafTriangles = 400;
+    auto sphereBsp = buildLocalBsp(test::sphereGridMesh(64, 48, 0.5f), fine);
+    ASSERT_TRUE(sphereBsp.ok());
+    SceneObjects objects;
+    const ModelId sphere = objects.addModel(sphereBsp.take());
+    const ModelId cube = objects.addModel(cubeModel(0.4f));
+    const std::size_t clusters = objects.model(sphere).clusters.clusters.size();
+    ASSERT_GT(clusters, 64u);  // more than one word
+    ObjectHandle a = objects.addObject(sphere, Transform{}).take();
+    VisibilityHistory history;
+
+    std::span<std::uint64_t> bits = history.clusterBits(a.index, objects);
+    ASSERT_EQ(bits.size(), (clusters + 63) / 64);
+    EXPECT_TRUE(std::all_of(bits.begin(), bits.end(), [](std::uint64_t w) { return w == 0; }));
+    bits[0] = 0b101;
+    bits[bits.size() - 1] = 1;
+    history.at({a.index, 0}, objects).lastVisible = true;  // creating node records keeps the bits
+    bits = history.clusterBits(a.index, objects);
+    EXPECT_EQ(bits[0], 0b101u);
+    EXPECT_EQ(bits[bits.size() - 1], 1u);
+
+    // The slot reused by another sphere: nothing of the old object's bits is left.
+    ASSERT_TRUE(objects.removeObject(a).ok());
+    ObjectHandle b = objects.addObject(sphere, Transform{}).take();
+    ASSERT_EQ(b.index, a.index);
+    bits = history.clusterBits(b.index, objects);
+    EXPECT_TRUE(std::all_of(bits.begin(), bits.end(), [](std::uint64_t w) { return w == 0; }));
+    EXPECT_FALSE(history.at({b.index, 0}, objects).lastVisible);
+
+    // Its model changed to a cube's: one leaf, a cluster or two, a fresh word.
+    bits[0] = ~std::uint64_t{0};
+    ASSERT_TRUE(objects.setModel(b, cube).ok());
+    bits = history.clusterBits(b.index, objects);
+    EXPECT_EQ(bits.size(), (objects.model(cube).clusters.clusters.size() + 63) / 64);
+    EXPECT_TRUE(std::all_of(bits.begin(), bits.end(), [](std::uint64_t w) { return w == 0; }));
+    history.clear();
+    EXPECT_EQ(history.clusterBits(b.index, objects).size(), bits.size());
+}

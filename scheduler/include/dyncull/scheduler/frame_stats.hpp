@@ -24,7 +24,12 @@ struct FrameStats {
     std::uint32_t clusterTests = 0;     ///< clusters of drawn parts tested (SchedulerFeatures::useClusters)
     std::uint32_t clustersCulled = 0;   ///< of those, left undrawn: facing away, outside the frustum or behind the pyramid
     std::uint64_t clusterTrianglesCulled = 0;  ///< their triangles (not in trianglesDrawn)
-    double clusterMs = 0.0;             ///< CPU in the cluster tests
+    /// Two-phase with cluster history: clusters of early parts held back from the early
+    /// pass (hidden at the end of the frame their part was last drawn in), and of those
+    /// the late pass drew (the pyramid could not reject them).
+    std::uint32_t clustersDeferred = 0;
+    std::uint32_t deferredClustersDrawn = 0;
+    double clusterMs = 0.0;             ///< CPU in the cluster tests, and in the final-depth tests of cluster history
     std::uint64_t queryTriangles = 0;   ///< triangles of the query volumes drawn (12 per box)
     std::uint32_t queriesOccluded = 0;  ///< answered "occluded"
     std::uint32_t queriesTimedOut = 0;  ///< never answered within the bound; counted visible

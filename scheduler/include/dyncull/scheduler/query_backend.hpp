@@ -175,6 +175,11 @@ public:
     virtual void drawPartRanges(NodeRef part, std::span<const IndexRange> ranges) {
         for (const IndexRange& r : ranges) drawPart(part, r.firstIndex, r.indexCount);
     }
+    /// Draws more `ranges` of a part that drawPartRanges drew earlier this frame (the late
+    /// pass's share of its clusters: SchedulerFeatures::useClusterHistory), as
+    /// drawPartRanges draws them, without counting the part again. Only called where
+    /// drawsRanges() is true; the default draws them through drawPartRanges.
+    virtual void drawMorePartRanges(NodeRef part, std::span<const IndexRange> ranges) { drawPartRanges(part, ranges); }
     /// Whether models with FaceMode::CullBack are drawn with their back faces culled now, so
     /// a cluster facing away from the eye shows nothing (false: the default).
     virtual bool cullsBackFaces() const { return false; }

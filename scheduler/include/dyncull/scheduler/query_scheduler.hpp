@@ -89,6 +89,15 @@ struct SchedulerFeatures {
     /// model weighs `clusterTestNs` per cluster against the drawing it saves, at each
     /// model's measured rate. Off: whole parts (an ablation).
     bool useClusters = true;
+    /// TwoPhase with clusters: the early set at cluster level. Each part drawn early is
+    /// drawn as only those clusters whose boxes showed in the final depth of the frame it
+    /// was last drawn in (VisibilityHistory::clusterBits, written at each frame's end from a
+    /// pyramid of the final depth); its other clusters wait for the late pass, which draws
+    /// those the early pass's pyramid cannot reject. The early depth is drawn from fewer
+    /// triangles; nothing is culled that the late pass did not test, so it stays
+    /// conservative. Costs a second depth readback per frame that tests. Off: parts drawn
+    /// early whole (an ablation).
+    bool useClusterHistory = true;
     /// TwoPhase (and clusters): test only where SchedulerTuning::costs expects the test to
     /// pay. Off: every volume the pyramid lets through is tested (an ablation).
     bool useCostModel = true;
@@ -292,6 +301,10 @@ public:
 private:
     // Stages shared by the modes (query_scheduler.cpp).
     enum class FirstTest : std::uint8_t { Invisible, Visible, NeedQuery };
+    /// Which of a part's clusters a draw considers: all, in the early pass with cluster
+    /// history only those that showed at the end of last frame (the others are deferred),
+    /// and in the late pass only the deferred ones.
+    enum class ClusterPass : std::uint8_t { All, Early, Deferred };
     /// Algorithm 3: frustum, near plane, front-most leaves, small features, history.
     FirstTest firstVisibilityTest(Frame& f, NodeRef ref, const Aabb& box, NodeHistory& h);
     struct Visit {
@@ -304,7 +317,7 @@ private:
     /// Algorithm 4: draws part `ref` or pushes its children. `untested`: decided visible
     /// without a query this frame (gets a draw query).
     void processVisible(Frame& f, NodeRef ref, NodeHistory& h, bool untested);
-    void drawNode(Frame& f, NodeRef ref, bool untested);
+    void drawNode(Frame& f, NodeRef ref, bool untested, ClusterPass pass = ClusterPass::All);
     /// Pushes `ref`'s children front to back onto active_ (the nearest on top), leaving out
     /// objects with a role, which the traversal never reaches (object_roles.cpp).
     void pushChildren(Frame& f, NodeRef ref);
@@ -449,7 +462,29 @@ private:
     /// Tests the clusters of part `ref` (node `n` of `model`) where they may pay, leaving
     /// the survivors in clusterRanges_ (adjacent ones merged); false if the part is to be
     /// drawn whole.
-    bool cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, const LocalBspNode& n);
+    bool cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, const LocalBspNode& n, ClusterPass pass);
+    // useClusterHistory: the parts drawn early that deferred clusters, and every part whose
+    // clusters were drawn or tested this frame (their bits are written at the frame's end).
+    struct DeferredPart {
+        NodeRef ref;
+        bool drawn;           ///< some of its clusters were drawn early
+        std::uint32_t trace;  ///< its entry in the frame's trace, or kInvalidIndex
+    };
+    std::vector<DeferredPart> deferredParts_;
+    std::vector<NodeRef> clusterParts_;
+    std::uint32_t lastDeferred_ = 0;  // clusters the last cullClusters call deferred
+    /// Cluster history's cost model: this frame's deferred triangles that the late pass did
+    /// not draw, the drawing they saved the last frame that used bits (ns), what the last
+    /// recording cost (ns, CPU and readback), and that recording's frame.
+    std::uint64_t deferredTriangles_ = 0;
+    double clusterBitsSavedNs_ = 1e300, clusterRecordNs_ = 0.0;
+    std::uint32_t lastClusterRecordFrame_ = ~0u - 1;
+    /// The late pass's share of the early parts: their deferred clusters that the pyramid
+    /// cannot reject, drawn.
+    void drawDeferredClusters(Frame& f);
+    /// At the frame's end: the final depth read back into the pyramid and every cluster of
+    /// clusterParts_ tested against it, into the parts' cluster bits.
+    void recordClusterVisibility(Frame& f);
 };
 
 }  // namespace dyncull

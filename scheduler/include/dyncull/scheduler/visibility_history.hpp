@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "dyncull/bsp/traversal.hpp"
@@ -42,6 +43,13 @@ public:
     /// The record for `ref` if there is one for the object as it is now (same generation
     /// and model), else nullptr; never creates one.
     const NodeHistory* find(NodeRef ref, const SceneObjects& objects) const;
+    /// One bit per cluster of the object's model (LocalBsp::clusters, in order; bit i of
+    /// the span is word i / 64, bit i % 64), kept, created and reset with the object's
+    /// node records: the cluster-level history of TwoPhase (SchedulerFeatures::
+    /// useClusterHistory), where a set bit means the cluster's box showed in the final
+    /// depth of the last frame its part was drawn in. Empty for a model without clusters.
+    /// Valid until the next call that creates records.
+    std::span<std::uint64_t> clusterBits(std::uint32_t object, const SceneObjects& objects);
     void clear();
 
     void recordAnswer(NodeHistory& h, bool visible, std::uint32_t frame) const;
@@ -59,9 +67,13 @@ public:
     std::size_t memoryBytes() const;
 
 private:
+    /// Makes `slot`'s block of records and cluster bits current for the object in it.
+    void ensureBlock(std::uint32_t slot, const SceneObjects& objects);
     std::vector<NodeHistory> scene_;
     std::vector<NodeHistory> objectNodes_;
+    std::vector<std::uint64_t> clusterWords_;
     std::vector<std::uint32_t> objectBase_;  // per slot: first record, or kInvalidIndex
+    std::vector<std::uint32_t> objectClusterBase_;  // per slot: first word of its cluster bits
     std::vector<std::uint32_t> objectGen_;   // per slot: generation the block belongs to
     std::vector<std::uint32_t> objectModel_;
 };

@@ -1,0 +1,81 @@
+// Cluster history: TwoPhase's early set kept per cluster, as niagara keeps a visibility bit
+// per meshlet for its two-phase culling (the scheme in
+// ../shared/notes/batched-occlusion-tests.md: visibility stored for the next frame). At a
+// frame's end the final depth is read back into the pyramid and every cluster of the parts
+// drawn is tested against it; next frame an early part draws only the clusters that showed,
+// and the late pass tests the others against the early pyramid (cluster_culling.cpp). The
+// bits only choose what is drawn early, so a wrong bit costs time, never a pixel.
+#include <algorithm>
+
+#include "cull_frame.hpp"
+
+namespace dyncull {
+
+void QueryScheduler::drawDeferredClusters(Frame& f) {
+    const SceneObjects& objs = f.objects;
+    for (const DeferredPart& d : deferredParts_) {
+        const LocalBsp& model = objs.model(objs.modelOf(d.ref.object));
+        cullClusters(f, d.ref, model, model.nodes[d.ref.node], ClusterPass::Deferred);
+        if (clusterRanges_.empty()) {
+            // None of its clusters drawn in either pass: it was not drawn.
+            if (!d.drawn && d.trace != kInvalidIndex) (*f.trace)[d.trace].state = NodeState::ClusterCulled;
+            continue;
+        }
+        const auto t0 = SchedulerClock::now();
+        if (d.drawn) {
+            f.sink.drawMorePartRanges(d.ref, clusterRanges_);
+        } else {
+            f.sink.drawPartRanges(d.ref, clusterRanges_);
+            ++f.stats.partsDrawn;
+        }
+        f.stats.drawMs += msSince(t0);
+        for (const IndexRange& r : clusterRanges_) f.stats.trianglesDrawn += r.indexCount / 3;
+    }
+}
+
+void QueryScheduler::recordClusterVisibility(Frame& f) {
+    // The final depth holds every occluder the frame drew, so it hides the most clusters;
+    // what it says only chooses next frame's early draws.
+    const auto t0 = SchedulerClock::now();
+    int w = 0, h = 0;
+    const bool haveDepth = f.backend.readDepth(depth_, w, h) && w == f.view.width && h == f.view.height;
+    if (haveDepth) pyramid_.build(depth_, w, h);
+    f.stats.depthReadMs += msSince(t0);
+    if (!haveDepth) return;  // the bits stay as they were
+    const auto t1 = SchedulerClock::now();
+    const SceneObjects& objs = f.objects;
+    const bool ortho = f.camera().orthographic();
+    for (const NodeRef ref : clusterParts_) {
+        const LocalBsp& model = objs.model(objs.modelOf(ref.object));
+        const std::span<const LeafCluster> clusters = model.clusters.ofSubtree(ref.node, model.nodes[ref.node].subtreeSize);
+        const std::span<std::uint64_t> bits = history_.clusterBits(ref.object, objs);
+        const std::uint32_t first = model.clusters.nodeFirst[ref.node];
+        const glm::mat4& matrix = objs.matrix(ref.object);
+        const glm::mat4 toClip = f.screen.clipMatrixOf(matrix);
+        // A cluster facing away now is left to next frame's late pass, should it turn: the
+        // cone test is cheaper than the projection.
+        const bool cones = model.faces == FaceMode::CullBack && f.sink.cullsBackFaces();
+        const glm::dmat4 toObject = glm::inverse(glm::dmat4(matrix));
+        const glm::dvec3 eye = glm::dvec3(toObject * glm::dvec4(glm::dvec3(f.camera().position), 1.0));
+        const glm::dvec3 along = glm::dvec3(toObject * glm::dvec4(glm::dvec3(f.camera().forward()), 0.0));
+        for (std::uint32_t i = 0; i < clusters.size(); ++i) {
+            const std::uint32_t k = first + i;
+            const std::uint64_t bit = std::uint64_t{1} << (k & 63);
+            const LeafCluster& c = clusters[i];
+            // No guarantee needed here (a deferred cluster is tested in the late pass), so
+            // the box is projected roughly: in float, without rounding margins.
+            ScreenRect rect;
+            float nearest = 1.0f;
+            if ((cones && (ortho ? c.backFacingAlong(along) : c.backFacingFrom(eye))) ||
+                (f.screen.roughBoxDepth(toClip, c.box, rect, nearest) && (rect.empty() || pyramid_.occluded(rect, nearest))))
+                bits[k >> 6] &= ~bit;
+            else
+                bits[k >> 6] |= bit;
+        }
+    }
+    f.stats.clusterMs += msSince(t1);
+    clusterRecordNs_ = 1e6 * msSince(t0);
+    lastClusterRecordFrame_ = f.index;
+}
+
+}  // namespace dyncull
