@@ -8,7 +8,9 @@
 // `*-discard` variants run the same frame with GL_RASTERIZER_DISCARD: vertex work and
 // per-draw overhead only, so total minus discard is the rasterisation and fragment cost.
 // `parts*` and `test-*` draw or test every part in view through the part renderer, to
-// weigh the two-phase mode's draw marks and triangle tests against drawing.
+// weigh the two-phase mode's draw marks and triangle tests against drawing. `full` is the
+// default conservative mode's whole frame (culling, tests and draws, its history carried
+// from frame to frame), for issue 21's ratio of `full` to `sol` measured in one run.
 //
 // Usage: bench_draw_speed [--frames N] [--count 300] [--box 8] [--bunny-size 1]
 //        [--orbit 12] [--speed 0.02] [--size 640x360] [--out DIR] [--mesh FILE]
@@ -265,6 +267,13 @@ struct Swarm {
         p.mode = CullMode::Vfc;
         return p;
     }()};
+    /// The default conservative mode (two-phase), and the same with early parts drawn whole.
+    QueryScheduler full{SchedulerParams{}};
+    QueryScheduler fullNoClusterHistory{[] {
+        SchedulerParams p;
+        p.features.useClusterHistory = false;
+        return p;
+    }()};
 };
 
 Swarm makeSwarm(GlContext& ctx, BunnySwarmOptions options) {
@@ -409,6 +418,18 @@ int main(int argc, char** argv) {
                         partFrame(PartLoop::Kind::TestVisible), {}, 0, {}});
     variants.push_back({"test-hidden", "every part tested on its own triangles behind a wall (every fragment fails)",
                         partFrame(PartLoop::Kind::TestHidden), {}, 0, {}});
+    auto cullFrame = [](Swarm& s, QueryScheduler& scheduler) {
+        return [&s, &scheduler]() -> std::uint64_t {
+            s.engine->context().clearFramebuffer(Renderer::kClearColour);
+            auto st = s.engine->renderFrame(scheduler);
+            if (!st) fail(st.error().message);
+            return st->trianglesDrawn;
+        };
+    };
+    variants.push_back({"full", "dyncull's default conservative mode (two-phase, cluster history), its own history from frame to frame",
+                        cullFrame(tuned, tuned.full), {}, 0, {}});
+    variants.push_back({"full-noclusterhist", "full with early parts drawn with all their clusters",
+                        cullFrame(tuned, tuned.fullNoClusterHistory), {}, 0, {}});
     variants.push_back({"vfc-before", "the renderer before issue 21: per-pixel, two-sided, load order, whole parts",
                         vfcFrame(unordered, Shading::Pixel, false, false, false), {}, 0, {}});
 
