@@ -97,7 +97,7 @@ bool applyTwoPhaseName(const std::string& part, ModeSpec& m) {
 
 std::string modeNamesHelp() {
     return "vfc, simple, full (two-phase: draw last frame's visible parts, test the rest against their depth pyramid, then what it cannot reject in one batched raster test where that pays), "
-           "queries (hardware occlusion queries with history, batching and occupancy maps; the default before two-phase), oracle; "
+           "queries (hardware occlusion queries with history, batching and occupancy maps; the default before two-phase), oracle (the visible parts, whole), oracle-clusters (only their clusters that own a pixel); "
            "ablations of full: full-hzb (the pyramid alone), full-tri (every part whose volume passes then tested on its own triangles, and draws marked), full-nohist (every part drawn early tested again each frame), full-nocost (every volume the pyramid lets through tested), full-noclusters (parts drawn whole, no cluster tests), full-noclusterhist (early parts drawn with all their clusters, not only those that showed last frame); "
            "vfc-noclusters (vfc drawing parts whole); "
            "approximate full: budgetP (at most P percent of the frame's pixels lost, e.g. budget0.1), budgetearlyP (and early-set parts showing less than the budget handed to it), budgetrecountP (the parts that could fit drawn last, counted again against the depth of the rest); "
@@ -237,8 +237,9 @@ Expected<ModeSpec> modeFromName(const std::string& name) {
         m.scheduler.features.useClusters = name == "vfc";
     } else if (name == "simple") {
         m.scheduler.mode = CullMode::Simple;
-    } else if (name == "oracle") {
+    } else if (name == "oracle" || name == "oracle-clusters") {
         m.oracle = true;
+        m.oracleClusters = name == "oracle-clusters";
     } else {
         // `full` or one of its ablations, or settings of `queries`, combined with '+'
         // (thr16+latency1); at most one part is a volume.
@@ -362,6 +363,8 @@ Expected<std::unique_ptr<BenchRunner>> BenchRunner::create(Engine& engine, DemoS
     auto gt = GroundTruth::create(engine.context());
     if (!gt) return gt.error();
     r->groundTruth_ = gt.take();
+    // Visible clusters only where a mode needs them: the ID pass costs twice as much then.
+    r->groundTruth_->setClusterIds(std::any_of(modes.begin(), modes.end(), [](const ModeSpec& m) { return m.oracleClusters; }));
     r->groundTruth_->setMeshSubstitute(scene.truthGeometry());
     BenchResult& res = r->result_;
     res.modes = std::move(modes);
@@ -392,6 +395,7 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
     ft.coveredPixels = truth_.coveredPixels;
     ft.artefactPixels = truth_.artefactPixels;
     for (const NodeRef& k : truth_.parts) ft.visibleTriangles += engine_.objects().model(engine_.objects().modelOf(k.object)).nodes[k.node].indexCount / 3;
+    ft.visibleClusterTriangles = truth_.visibleClusterTriangles;
 
     // The oracle draws the visible parts front-to-back like the other modes, so it gets
     // the same early-depth rejection and is a fair lower bound.
@@ -407,6 +411,28 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
     std::sort(byDistance.begin(), byDistance.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
     oracleParts_.clear();
     for (const auto& p : byDistance) oracleParts_.push_back(p.second);
+    oracleClusterRanges_.clear();
+    for (const NodeRef& ref : oracleParts_) {
+        if (truth_.clusterFirst.empty()) break;  // no mode draws them
+        const LocalBsp& model = engine_.objects().model(engine_.objects().modelOf(ref.object));
+        const auto at = std::lower_bound(truth_.parts.begin(), truth_.parts.end(), ref);
+        const auto i = static_cast<std::size_t>(at - truth_.parts.begin());
+        const std::size_t first = truth_.clusterFirst[i], last = truth_.clusterFirst[i + 1];
+        if (first == last) {  // no clusters: the whole part
+            const LocalBspNode& n = model.nodes[ref.node];
+            oracleClusterRanges_.push_back({ref, n.firstIndex, n.indexCount});
+            continue;
+        }
+        const std::size_t start = oracleClusterRanges_.size();
+        for (std::size_t c = first; c < last; ++c) {
+            const LeafCluster& cl = model.clusters.clusters[truth_.clusters[c]];
+            PartRange* prev = oracleClusterRanges_.size() > start ? &oracleClusterRanges_.back() : nullptr;
+            if (prev && prev->firstIndex + prev->indexCount == cl.firstIndex)
+                prev->indexCount += cl.indexCount;
+            else
+                oracleClusterRanges_.push_back({ref, cl.firstIndex, cl.indexCount});
+        }
+    }
 
     std::vector<ModeFrame> row(result_.modes.size());
     // vfc first (its image is the reference), the others in an order rotated every frame:
@@ -422,7 +448,9 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
         // The reference image is complete even where the scene may skip work (streamed
         // leaves not yet read), so what a mode skips counts as its error.
         scene_.setReferencePass(m == 0);
-        auto rendered = spec.oracle ? engine_.renderParts(oracleParts_) : engine_.renderFrame(*schedulers_[m]);
+        auto rendered = spec.oracleClusters ? engine_.renderPartRanges(oracleClusterRanges_)
+                        : spec.oracle       ? engine_.renderParts(oracleParts_)
+                                            : engine_.renderFrame(*schedulers_[m]);
         scene_.setReferencePass(false);
         if (schedulers_[m]) schedulers_[m]->setTrace(nullptr);
         if (!rendered) {

@@ -28,6 +28,9 @@ namespace dyncull::cli {
 struct ModeSpec {
     std::string name;
     bool oracle = false;
+    /// With `oracle`: draws only the clusters of the visible parts that own a pixel (the
+    /// floor of a culler at cluster granularity), not the visible parts whole.
+    bool oracleClusters = false;
     SchedulerParams scheduler;
     GlQueryParams queries;
     /// The family of settings this mode belongs to, one curve in the speed-accuracy plot:
@@ -116,6 +119,7 @@ struct FrameTruth {
     double updateMs = 0.0;            ///< loose-BSP relink, once per frame for all modes
     std::uint32_t artefactPixels = 0; ///< ID-pass pixels dropped as depth artefacts (VisibleSet::artefactPixels)
     std::uint64_t visibleTriangles = 0;  ///< triangles of the visible parts (what the oracle draws)
+    std::uint64_t visibleClusterTriangles = 0;  ///< triangles of their clusters that own a pixel (what oracle-clusters draws)
     bool boundMeasured = false;          ///< the two bounds below were measured (--volume-bound)
     VolumeBound boundAabb, boundAuto;    ///< with transformed local boxes, and with the auto volumes
 };
@@ -165,6 +169,7 @@ private:
     VisibleSet truth_;
     std::vector<Image> images_;
     std::vector<NodeRef> oracleParts_;
+    std::vector<PartRange> oracleClusterRanges_;  // oracle-clusters: oracleParts_' visible clusters, adjacent ones merged
     std::vector<NodeTrace> trace_;
     bool measureBound_ = false;
     std::vector<std::vector<NodeRef>> missing_;  // per mode: last frame's visible parts not drawn

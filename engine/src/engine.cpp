@@ -372,4 +372,30 @@ Expected<FrameStats> Engine::renderParts(const std::vector<NodeRef>& parts) {
     });
 }
 
+Expected<FrameStats> Engine::renderPartRanges(std::span<const PartRange> ranges) {
+    return drawFrame(views_[kMainView], "renderPartRanges", [&](const FrameView&, Sink& sink) {
+        FrameStats st;
+        const auto tDraw = std::chrono::steady_clock::now();
+        std::vector<IndexRange> partRanges;
+        for (std::size_t i = 0; i < ranges.size();) {
+            const NodeRef ref = ranges[i].part;
+            assert(!ref.isSceneNode() && ref.object < objects_.slotCount() && objects_.alive(ref.object));
+            partRanges.clear();
+            for (; i < ranges.size() && ranges[i].part == ref; ++i) {
+                partRanges.push_back({ranges[i].firstIndex, ranges[i].indexCount});
+                st.trianglesDrawn += ranges[i].indexCount / 3;
+            }
+            if (sink.drawsRanges()) {
+                sink.drawPartRanges(ref, partRanges);
+            } else {
+                for (const IndexRange& r : partRanges) sink.drawPart(ref, r.firstIndex, r.indexCount);
+            }
+            ++st.partsDrawn;
+        }
+        st.drawMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tDraw).count();
+        st.nodesVisited = st.partsDrawn;
+        return st;
+    });
+}
+
 }  // namespace dyncull

@@ -12,6 +12,8 @@ TEST(BenchModes, BaseModes) {
     EXPECT_EQ(modeFromName("vfc")->scheduler.mode, CullMode::Vfc);
     EXPECT_EQ(modeFromName("simple")->scheduler.mode, CullMode::Simple);
     EXPECT_TRUE(modeFromName("oracle")->oracle);
+    EXPECT_FALSE(modeFromName("oracle")->oracleClusters);
+    EXPECT_TRUE(modeFromName("oracle-clusters")->oracle && modeFromName("oracle-clusters")->oracleClusters);
     const ModeSpec full = modeFromName("full").take();
     EXPECT_EQ(full.scheduler.mode, CullMode::TwoPhase);
     EXPECT_TRUE(full.scheduler.features.useBatchedRaster && full.scheduler.features.useCostModel && full.scheduler.features.useHistory);

@@ -97,7 +97,7 @@ protected:
 TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
     ASSERT_NO_FATAL_FAILURE(build("dyncull_conservative_", 30));
 
-    const char* conservative = "vfc,simple,full,full-hzb,full-nohist,full-nocost,full-tri,full-noclusters,full-noclusterhist,queries,queries-nohist,queries-nobatch,queries-noocc,queries-notight,queries-nodrawq,order,front10,oracle,thr64";
+    const char* conservative = "vfc,simple,full,full-hzb,full-nohist,full-nocost,full-tri,full-noclusters,full-noclusterhist,queries,queries-nohist,queries-nobatch,queries-noocc,queries-notight,queries-nodrawq,order,front10,oracle,oracle-clusters,thr64";
     auto modes = cli::modesFromList(conservative);
     ASSERT_TRUE(modes.ok()) << modes.error().message;
     // The test checks culling, not latency: a query that outlasts the default 250 ms bound
@@ -112,6 +112,7 @@ TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
 
     std::uint64_t visibleSeen = 0, thresholdMisses = 0, occludedSeen = 0, queries = 0, drawQueriesOccluded = 0, boundSlack = 0;
     std::uint64_t rasterTests = 0, rasterParts = 0, pyramidParts = 0;  // full with and without the batched raster test
+    std::uint64_t clusterTriangles = 0, partTriangles = 0;  // the visible clusters' and parts' triangles
     double worstPercent = 0.0;
     for (std::uint64_t frame = 0; frame < bo.frames; ++frame) {
         ASSERT_TRUE((*runner)->runFrame(frame).ok());
@@ -131,6 +132,13 @@ TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
         for (std::size_t m = 0; m < row.size(); ++m) {
             if (names[m].oracle) {
                 EXPECT_EQ(row[m].parts.falsePositives, 0u);  // exactly the visible set
+            }
+            if (names[m].oracleClusters) {
+                // Only the clusters owning a pixel, and still the whole picture (checked below).
+                EXPECT_EQ(row[m].stats.trianglesDrawn, truth.visibleClusterTriangles);
+                EXPECT_LE(truth.visibleClusterTriangles, truth.visibleTriangles);
+                clusterTriangles += truth.visibleClusterTriangles;
+                partTriangles += truth.visibleTriangles;
             }
             if (names[m].name == "thr64") {
                 thresholdMisses += row[m].parts.falseNegatives;
@@ -158,6 +166,9 @@ TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
                 static_cast<unsigned long long>(queries), worstPercent, static_cast<unsigned long long>(thresholdMisses));
     // The flight must show parts and hide others, or the test proves nothing.
     EXPECT_GT(visibleSeen, 100u);
+    // Visible parts are partly hidden: fewer of their clusters than all of them show.
+    EXPECT_LT(clusterTriangles, partTriangles);
+    EXPECT_GT(clusterTriangles, 0u);
     EXPECT_GT(occludedSeen, 100u);
     EXPECT_GT(thresholdMisses, 0u) << "a 64-pixel threshold should drop some small visible parts";
     // Real GL draw queries answered, and some parts drawn untested turned out hidden.

@@ -38,6 +38,18 @@ layout(location = 0) out uint outId;
 void main() { outId = uId; }
 )";
 
+// With cluster ids: the primitive id, counted from the part's first triangle (each part
+// is one draw), names the cluster that owns the pixel.
+const char* const kIdClusterFragmentShader = R"(#version 450 core
+uniform uint uId;
+layout(location = 0) out uint outId;
+layout(location = 1) out uint outPrimitive;
+void main() {
+    outId = uId;
+    outPrimitive = uint(gl_PrimitiveID);
+}
+)";
+
 }  // namespace
 
 glm::vec2 GroundTruth::windowDepthRange(const SceneObjects& objects, NodeRef ref, const Camera& camera,
@@ -75,11 +87,14 @@ std::uint32_t VisibleSet::pixelsOf(NodeRef key) const {
 Expected<std::unique_ptr<GroundTruth>> GroundTruth::create(GlContext& context) {
     std::unique_ptr<GroundTruth> g(new GroundTruth(context));
     std::string log;
-    g->program_ = detail::buildProgram(kIdVertexShader, kIdFragmentShader, log);
-    if (!g->program_) return Error{"ground truth: id shader rejected by " + context.rendererName() + ": " + log};
-    g->locViewProj_ = glGetUniformLocation(g->program_, "uViewProj");
-    g->locModel_ = glGetUniformLocation(g->program_, "uModel");
-    g->locId_ = glGetUniformLocation(g->program_, "uId");
+    for (int clusters = 0; clusters < 2; ++clusters) {
+        IdProgram& p = g->programs_[clusters];
+        p.id = detail::buildProgram(kIdVertexShader, clusters ? kIdClusterFragmentShader : kIdFragmentShader, log);
+        if (!p.id) return Error{"ground truth: id shader rejected by " + context.rendererName() + ": " + log};
+        p.viewProj = glGetUniformLocation(p.id, "uViewProj");
+        p.model = glGetUniformLocation(p.id, "uModel");
+        p.partId = glGetUniformLocation(p.id, "uId");
+    }
     return g;
 }
 
@@ -93,8 +108,10 @@ GroundTruth::~GroundTruth() {
     }
     if (fbo_) glDeleteFramebuffers(1, &fbo_);
     if (colour_) glDeleteTextures(1, &colour_);
+    if (primitives_) glDeleteTextures(1, &primitives_);
     if (depth_) glDeleteTextures(1, &depth_);
-    if (program_) glDeleteProgram(program_);
+    for (const IdProgram& p : programs_)
+        if (p.id) glDeleteProgram(p.id);
 }
 
 void GroundTruth::upload(const Mesh& mesh, GpuModel& g) {
@@ -149,16 +166,20 @@ VisibleSet GroundTruth::compute(const SceneObjects& objects, const Camera& camer
     if (size.x != width_ || size.y != height_ || !fbo_) {
         if (fbo_) glDeleteFramebuffers(1, &fbo_);
         if (colour_) glDeleteTextures(1, &colour_);
+        if (primitives_) glDeleteTextures(1, &primitives_);
         if (depth_) glDeleteTextures(1, &depth_);
         width_ = size.x;
         height_ = size.y;
         glCreateTextures(GL_TEXTURE_2D, 1, &colour_);
         glTextureStorage2D(colour_, 1, GL_R32UI, width_, height_);
+        glCreateTextures(GL_TEXTURE_2D, 1, &primitives_);
+        glTextureStorage2D(primitives_, 1, GL_R32UI, width_, height_);
         // Same depth format as the context's FBO, so depth ties resolve identically.
         glCreateTextures(GL_TEXTURE_2D, 1, &depth_);
         glTextureStorage2D(depth_, 1, GL_DEPTH_COMPONENT32F, width_, height_);
         glCreateFramebuffers(1, &fbo_);
         glNamedFramebufferTexture(fbo_, GL_COLOR_ATTACHMENT0, colour_, 0);
+        glNamedFramebufferTexture(fbo_, GL_COLOR_ATTACHMENT1, primitives_, 0);
         glNamedFramebufferTexture(fbo_, GL_DEPTH_ATTACHMENT, depth_, 0);
     }
 
@@ -167,6 +188,9 @@ VisibleSet GroundTruth::compute(const SceneObjects& objects, const Camera& camer
     candidates_ = frustumLeavesBruteForce(objects, Frustum::fromCamera(camera));
 
     glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+    const GLenum buffers[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glNamedFramebufferDrawBuffers(fbo_, clusterIds_ ? 2 : 1, buffers);
+    const IdProgram& program = programs_[clusterIds_ ? 1 : 0];
     glViewport(0, 0, width_, height_);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glDepthMask(GL_TRUE);
@@ -179,9 +203,10 @@ VisibleSet GroundTruth::compute(const SceneObjects& objects, const Camera& camer
     glDepthFunc(detail::kDepthNearer);
     const GLuint zero[4] = {0, 0, 0, 0};
     glClearBufferuiv(GL_COLOR, 0, zero);
+    if (clusterIds_) glClearBufferuiv(GL_COLOR, 1, zero);
     glClearBufferfv(GL_DEPTH, 0, &detail::kDepthCleared);
-    glUseProgram(program_);
-    glUniformMatrix4fv(locViewProj_, 1, GL_FALSE, glm::value_ptr(viewProj));
+    glUseProgram(program.id);
+    glUniformMatrix4fv(program.viewProj, 1, GL_FALSE, glm::value_ptr(viewProj));
     for (std::size_t i = 0; i < candidates_.size(); ++i) {
         const NodeRef ref = candidates_[i];
         const ModelId model = objects.modelOf(ref.object);
@@ -191,8 +216,8 @@ VisibleSet GroundTruth::compute(const SceneObjects& objects, const Camera& camer
         static const glm::mat4 identity(1.0f);
         const glm::mat4& toWorld = gm.wholeCount ? identity : objects.matrix(ref.object);
         detail::setFaceCulling(cullEnabled, frontCcw, gm.cullBack, glm::mat3(toWorld));
-        glUniform1ui(locId_, static_cast<GLuint>(i + 1));
-        glUniformMatrix4fv(locModel_, 1, GL_FALSE, glm::value_ptr(camera.relativeModel(toWorld)));
+        glUniform1ui(program.partId, static_cast<GLuint>(i + 1));
+        glUniformMatrix4fv(program.model, 1, GL_FALSE, glm::value_ptr(camera.relativeModel(toWorld)));
         glBindVertexArray(gm.vao);
         const std::uint32_t first = gm.wholeCount ? 0 : n.firstIndex, count = gm.wholeCount ? gm.wholeCount : n.indexCount;
         glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(count), GL_UNSIGNED_INT,
@@ -208,6 +233,12 @@ VisibleSet GroundTruth::compute(const SceneObjects& objects, const Camera& camer
     glReadBuffer(GL_COLOR_ATTACHMENT0);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
     glReadPixels(0, 0, width_, height_, GL_RED_INTEGER, GL_UNSIGNED_INT, bottomUp.data());
+    if (clusterIds_) {
+        primitiveIds_.resize(bottomUp.size());
+        glReadBuffer(GL_COLOR_ATTACHMENT1);
+        glReadPixels(0, 0, width_, height_, GL_RED_INTEGER, GL_UNSIGNED_INT, primitiveIds_.data());
+        glReadBuffer(GL_COLOR_ATTACHMENT0);
+    }
     glReadPixels(0, 0, width_, height_, GL_DEPTH_COMPONENT, GL_FLOAT, depths_.data());
     glBindFramebuffer(GL_FRAMEBUFFER, context_.framebuffer());
     context_.checkErrors();
@@ -253,8 +284,52 @@ VisibleSet GroundTruth::compute(const SceneObjects& objects, const Camera& camer
     }
     // frustumLeavesBruteForce lists slot then node order, so parts are already sorted.
     assert(std::is_sorted(vs.parts.begin(), vs.parts.end()));
+    if (clusterIds_) visibleClusters(objects, bottomUp, vs);
     lastMs_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     return vs;
+}
+
+void GroundTruth::visibleClusters(const SceneObjects& objects, std::span<const std::uint32_t> ids, VisibleSet& vs) {
+    // Each pixel's primitive, counted from its part's first index, lies in one cluster of
+    // the part (its clusters tile the part's range in index order).
+    clusterKeys_.clear();
+    for (std::size_t k = 0; k < ids.size(); ++k) {
+        const std::uint32_t id = ids[k];
+        if (id == 0 || id > candidates_.size()) continue;
+        const NodeRef ref = candidates_[id - 1];
+        if (ref.object < substitutes_.size() && substitutes_[ref.object].vao) continue;  // not the model's triangles
+        const LocalBsp& model = objects.model(objects.modelOf(ref.object));
+        if (!model.clusters.builtFor(model.nodes.size())) continue;
+        const LocalBspNode& n = model.nodes[ref.node];
+        const std::span<const LeafCluster> clusters = model.clusters.ofSubtree(ref.node, n.subtreeSize);
+        if (clusters.empty()) continue;
+        const std::uint64_t index = std::uint64_t{n.firstIndex} + 3 * std::uint64_t{primitiveIds_[k]};
+        auto after = std::upper_bound(clusters.begin(), clusters.end(), index,
+                                      [](std::uint64_t i, const LeafCluster& c) { return i < c.firstIndex; });
+        if (after == clusters.begin()) continue;  // cannot happen: the first cluster starts at the part's first index
+        const auto c = static_cast<std::uint32_t>(model.clusters.nodeFirst[ref.node] + (after - 1 - clusters.begin()));
+        clusterKeys_.push_back(std::uint64_t{id - 1} << 32 | c);
+    }
+    std::sort(clusterKeys_.begin(), clusterKeys_.end());
+    clusterKeys_.erase(std::unique(clusterKeys_.begin(), clusterKeys_.end()), clusterKeys_.end());
+    // Visible parts are the candidates with pixels, in candidate order, as are the keys.
+    vs.clusterFirst.assign(1, 0);
+    vs.clusters.clear();
+    vs.visibleClusterTriangles = 0;
+    std::size_t key = 0;
+    for (std::size_t p = 0; p < vs.parts.size(); ++p) {
+        const NodeRef ref = vs.parts[p];
+        while (key < clusterKeys_.size() && candidates_[clusterKeys_[key] >> 32] < ref) ++key;
+        const LocalBsp& model = objects.model(objects.modelOf(ref.object));
+        const std::size_t before = vs.clusters.size();
+        for (; key < clusterKeys_.size() && candidates_[clusterKeys_[key] >> 32] == ref; ++key) {
+            const auto c = static_cast<std::uint32_t>(clusterKeys_[key] & 0xffffffffu);
+            vs.clusters.push_back(c);
+            vs.visibleClusterTriangles += model.clusters.clusters[c].indexCount / 3;
+        }
+        if (vs.clusters.size() == before) vs.visibleClusterTriangles += model.nodes[ref.node].indexCount / 3;  // no clusters: the whole part
+        vs.clusterFirst.push_back(static_cast<std::uint32_t>(vs.clusters.size()));
+    }
 }
 
 std::vector<NodeRef> drawnLeaves(const SceneObjects& objects, std::span<const VisiblePart> parts) {

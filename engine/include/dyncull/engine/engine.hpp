@@ -154,6 +154,11 @@ public:
     /// no culling and no queries, timed like renderFrame (the oracle lower bound of `dyncull
     /// bench`). Every ref must name a live object and a node of its model. Errors: context lost.
     Expected<FrameStats> renderParts(const std::vector<NodeRef>& parts);
+    /// The same with each part drawn as index ranges of its model's split mesh (the cluster
+    /// oracle of `dyncull bench`): consecutive entries naming one part are its ranges,
+    /// ascending, disjoint and inside the part's own range; the part counts once. Drawn in
+    /// one multi-draw where the part renderer draws, else range by range.
+    Expected<FrameStats> renderPartRanges(std::span<const PartRange> ranges);
     /// The parts the view's last frame drew (renderFrame/renderParts for the main view), in
     /// the order drawn (front to back within each pass); empty after a frame that returned
     /// an error before drawing, and for an unknown view. Valid until the view's next frame.

@@ -33,13 +33,22 @@ struct VisibleSet {
     /// outside the window-depth range of its own part's box, so it is no surface point
     /// (see GroundTruth::compute). Not in `pixels` nor `coveredPixels`.
     std::uint32_t artefactPixels = 0;
+    /// Per visible part i, the clusters owning at least one of its pixels:
+    /// clusters[clusterFirst[i] .. clusterFirst[i + 1]), ascending indices into its model's
+    /// LocalBsp::clusters. None for a part without clusters or drawn from a substitute mesh
+    /// (its pixels are the part's alone). clusterFirst has parts.size() + 1 entries.
+    std::vector<std::uint32_t> clusterFirst;  ///< empty unless GroundTruth::setClusterIds
+    std::vector<std::uint32_t> clusters;
+    /// Triangles of those clusters, plus the whole triangles of visible parts without
+    /// clusters: what a culler at cluster granularity must draw at least.
+    std::uint64_t visibleClusterTriangles = 0;
 
     /// Pixels of `key`, 0 if not visible. O(log n).
     std::uint32_t pixelsOf(NodeRef key) const;
     bool contains(NodeRef key) const { return pixelsOf(key) > 0; }
 };
 
-/// Owns an FBO (R32UI ids + DEPTH32F) the size of the context and its own copy of every
+/// Owns an FBO (R32UI ids, R32UI primitive ids within each part's draw, DEPTH32F) the size of the context and its own copy of every
 /// model's positions and indices (uploaded on first use; models are never removed). The
 /// GlContext must outlive it and be current on every call. Leaves the context's
 /// framebuffer bound afterwards; other GL state the renderer sets per frame anyway.
@@ -62,6 +71,10 @@ public:
     using MeshSubstitute = std::function<bool(std::uint32_t objectSlot, Mesh&)>;
     void setMeshSubstitute(MeshSubstitute substitute) { substitute_ = std::move(substitute); }
 
+    /// Whether compute also finds each visible part's visible clusters (VisibleSet::clusters,
+    /// visibleClusterTriangles; else those stay empty and 0). Off by default: the ID pass
+    /// then writes each fragment's primitive id too, which took it twice as long on llvmpipe.
+    void setClusterIds(bool on) { clusterIds_ = on; }
     /// Ids of the last compute, top-down rows, width x height: 0 = background, else
     /// 1 + index into lastParts().
     const std::vector<std::uint32_t>& idImage() const { return ids_; }
@@ -75,6 +88,9 @@ private:
     /// Window-depth interval (reversed Z; with rounding slack) that every correct fragment
     /// of leaf `ref` lies in; [-1, 2] (no constraint) if its box reaches the near plane.
     /// `viewProj`: camera.viewProjectionRelativeDouble().
+    /// Fills vs.clusterFirst, clusters and visibleClusterTriangles from the last ID pass
+    /// (`ids`: its part ids after artefact removal, GL rows).
+    void visibleClusters(const SceneObjects& objects, std::span<const std::uint32_t> ids, VisibleSet& vs);
     static glm::vec2 windowDepthRange(const SceneObjects& objects, NodeRef ref, const Camera& camera,
                                       const glm::dmat4& viewProj);
 
@@ -92,13 +108,20 @@ private:
 
     GlContext& context_;
     MeshSubstitute substitute_;
-    std::uint32_t fbo_ = 0, colour_ = 0, depth_ = 0, program_ = 0;
-    int locViewProj_ = -1, locModel_ = -1, locId_ = -1;
+    std::uint32_t fbo_ = 0, colour_ = 0, primitives_ = 0, depth_ = 0;
+    struct IdProgram {
+        std::uint32_t id = 0;
+        int viewProj = -1, model = -1, partId = -1;
+    };
+    IdProgram programs_[2];  // [with cluster ids]
+    bool clusterIds_ = false;
     int width_ = 0, height_ = 0;
     std::vector<GpuModel> models_;
     std::vector<NodeRef> candidates_;
     std::vector<std::uint32_t> ids_;
     std::vector<std::uint32_t> counts_;
+    std::vector<std::uint32_t> primitiveIds_;    // last ID pass, GL rows (bottom-up)
+    std::vector<std::uint64_t> clusterKeys_;     // (candidate << 32 | cluster) of each pixel
     std::vector<float> depths_;        // last ID pass depth, GL rows (bottom-up)
     std::vector<glm::vec2> depthRange_;  // per candidate: windowDepthRange
     double lastMs_ = 0.0;
