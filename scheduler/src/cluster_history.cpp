@@ -11,6 +11,12 @@
 
 namespace dyncull {
 
+namespace {
+/// The record tests a cluster at the finest pyramid level its rectangle spans at most
+/// this many texels of (up to 256 reads; the late pass's tests read at most 16).
+constexpr int kRecordSpan = 16;
+}  // namespace
+
 void QueryScheduler::drawDeferredClusters(Frame& f) {
     const SceneObjects& objs = f.objects;
     for (const DeferredPart& d : deferredParts_) {
@@ -67,7 +73,7 @@ void QueryScheduler::recordClusterVisibility(Frame& f) {
             ScreenRect rect;
             float nearest = 1.0f;
             if ((cones && (ortho ? c.backFacingAlong(along) : c.backFacingFrom(eye))) ||
-                (f.screen.roughBoxDepth(toClip, c.box, rect, nearest) && (rect.empty() || pyramid_.occluded(rect, nearest))))
+                (f.screen.roughBoxDepth(toClip, c.box, rect, nearest) && (rect.empty() || pyramid_.occluded(rect, nearest, kRecordSpan))))
                 bits[k >> 6] &= ~bit;
             else
                 bits[k >> 6] |= bit;

@@ -68,11 +68,12 @@ float DepthPyramid::farthestIn(const ScreenRect& rect) const {
     return farthestInPixels(x0, y0, x1, y1);
 }
 
-float DepthPyramid::farthestInPixels(int x0, int y0, int x1, int y1) const {
-    // The finest level where the rectangle spans at most kMaxSpan texels on both axes (at
+float DepthPyramid::farthestInPixels(int x0, int y0, int x1, int y1, int maxSpan) const {
+    // The finest level where the rectangle spans at most maxSpan texels on both axes (at
     // the top level, 1x1, it always does); every texel it touches there is read.
+    assert(maxSpan >= 2);
     int k = 0;
-    while ((x1 >> k) - (x0 >> k) >= kMaxSpan || (y1 >> k) - (y0 >> k) >= kMaxSpan) ++k;
+    while ((x1 >> k) - (x0 >> k) >= maxSpan || (y1 >> k) - (y0 >> k) >= maxSpan) ++k;
     assert(k < levels());
     const Level& l = levels_[static_cast<std::size_t>(k)];
     float farthest = 1.0f;
@@ -83,10 +84,10 @@ float DepthPyramid::farthestInPixels(int x0, int y0, int x1, int y1) const {
     return farthest;
 }
 
-bool DepthPyramid::occluded(const ScreenRect& rect, float nearestDepth) const {
+bool DepthPyramid::occluded(const ScreenRect& rect, float nearestDepth, int maxSpan) const {
     int x0, y0, x1, y1;
     if (levels_.empty() || !clampRect(rect, width_, height_, x0, y0, x1, y1)) return false;  // no evidence
-    const float farthest = farthestInPixels(x0, y0, x1, y1);
+    const float farthest = farthestInPixels(x0, y0, x1, y1, maxSpan);
     // Reversed Z: behind means smaller. Equal or within the slack counts as visible.
     return nearestDepth < farthest - kDepthSlack * farthest;
 }

@@ -51,7 +51,11 @@ public:
     /// (kDepthSlack). False for an empty or off-screen rectangle (no evidence either way)
     /// and before the first build. The caller must have called the volume visible already if
     /// it crosses the near plane (then it has no meaningful nearest depth).
-    bool occluded(const ScreenRect& rect, float nearestDepth) const;
+    bool occluded(const ScreenRect& rect, float nearestDepth) const { return occluded(rect, nearestDepth, kMaxSpan); }
+    /// The same at the finest level where the rectangle spans at most `maxSpan` texels a
+    /// side (at most maxSpan^2 reads; maxSpan >= 2): a larger span costs more reads and is
+    /// hidden more often.
+    bool occluded(const ScreenRect& rect, float nearestDepth, int maxSpan) const;
 
     /// Relative margin on depths: the GPU's depth of a surface point and the CPU's exact
     /// depth of the volume around it differ by float rounding (a few ulp, 2^-23 each); the
@@ -60,7 +64,7 @@ public:
 
 private:
     /// farthestIn for inclusive pixel bounds already clamped to the screen.
-    float farthestInPixels(int x0, int y0, int x1, int y1) const;
+    float farthestInPixels(int x0, int y0, int x1, int y1, int maxSpan = kMaxSpan) const;
 
     struct Level {
         std::size_t offset = 0;
