@@ -72,11 +72,14 @@ void QueryScheduler::recordClusterVisibility(Frame& f) {
             // the box is projected roughly: in float, without rounding margins.
             ScreenRect rect;
             float nearest = 1.0f;
-            if ((cones && (ortho ? c.backFacingAlong(along) : c.backFacingFrom(eye))) ||
-                (f.screen.roughBoxDepth(toClip, c.box, rect, nearest) && (rect.empty() || pyramid_.occluded(rect, nearest, kRecordSpan))))
+            const bool hidden = (cones && (ortho ? c.backFacingAlong(along) : c.backFacingFrom(eye))) ||
+                                (f.screen.roughBoxDepth(toClip, c.box, rect, nearest) &&
+                                 (rect.empty() || pyramid_.occluded(rect, nearest, kRecordSpan)));
+            if (hidden) {
                 bits[k >> 6] &= ~bit;
-            else
+            } else {
                 bits[k >> 6] |= bit;
+            }
         }
     }
     f.stats.clusterMs += msSince(t1);

@@ -205,7 +205,8 @@ void QueryScheduler::drawNode(Frame& f, NodeRef ref, bool untested, ClusterPass 
         // The late pass decides on the rest of its clusters, and on its trace entry if
         // none is drawn now.
         const bool traced = f.trace && !f.trace->empty() && f.trace->back().ref == ref;
-        deferredParts_.push_back({ref, !clusterRanges_.empty(), traced ? static_cast<std::uint32_t>(f.trace->size() - 1) : kInvalidIndex});
+        const std::uint32_t entry = traced ? static_cast<std::uint32_t>(f.trace->size() - 1) : kInvalidIndex;
+        deferredParts_.push_back({ref, !clusterRanges_.empty(), entry});
         if (clusterRanges_.empty()) return;
     }
     if (clustered && clusterRanges_.empty()) {

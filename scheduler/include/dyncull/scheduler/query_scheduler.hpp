@@ -478,7 +478,7 @@ private:
     /// recording cost (ns, CPU and readback), and that recording's frame.
     std::uint64_t deferredTriangles_ = 0;
     double clusterBitsSavedNs_ = 1e300, clusterRecordNs_ = 0.0;
-    std::uint32_t lastClusterRecordFrame_ = ~0u - 1;
+    std::uint32_t lastClusterRecordFrame_ = ~0u - 1;  // none yet: one past it is no frame's "last frame" either
     /// The late pass's share of the early parts: their deferred clusters that the pyramid
     /// cannot reject, drawn.
     void drawDeferredClusters(Frame& f);
