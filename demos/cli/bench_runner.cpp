@@ -412,8 +412,8 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
     oracleParts_.clear();
     for (const auto& p : byDistance) oracleParts_.push_back(p.second);
     oracleClusterRanges_.clear();
-    for (const NodeRef& ref : oracleParts_) {
-        if (truth_.clusterFirst.empty()) break;  // no mode draws them
+    // Only where a mode draws them (GroundTruth::setClusterIds): each part's visible clusters.
+    for (const NodeRef& ref : truth_.clusterFirst.empty() ? std::span<const NodeRef>{} : std::span<const NodeRef>(oracleParts_)) {
         const LocalBsp& model = engine_.objects().model(engine_.objects().modelOf(ref.object));
         const auto at = std::lower_bound(truth_.parts.begin(), truth_.parts.end(), ref);
         const auto i = static_cast<std::size_t>(at - truth_.parts.begin());

@@ -354,22 +354,15 @@ Expected<FrameStats> Engine::cullAndDraw(View& view, QueryScheduler& scheduler) 
 }
 
 Expected<FrameStats> Engine::renderParts(const std::vector<NodeRef>& parts) {
-    return drawFrame(views_[kMainView], "renderParts", [&](const FrameView&, Sink& sink) {
-        FrameStats st;
-        const auto tDraw = std::chrono::steady_clock::now();
-        for (const NodeRef& ref : parts) {
-            assert(!ref.isSceneNode() && ref.object < objects_.slotCount() && objects_.alive(ref.object));
-            const LocalBsp& bsp = objects_.model(objects_.modelOf(ref.object));
-            assert(ref.node < bsp.nodes.size());
-            const LocalBspNode& n = bsp.nodes[ref.node];
-            sink.drawPart(ref, n.firstIndex, n.indexCount);
-            ++st.partsDrawn;
-            st.trianglesDrawn += n.indexCount / 3;
-        }
-        st.drawMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tDraw).count();
-        st.nodesVisited = st.partsDrawn;
-        return st;
-    });
+    std::vector<PartRange> whole;
+    whole.reserve(parts.size());
+    for (const NodeRef& ref : parts) {
+        assert(!ref.isSceneNode() && ref.object < objects_.slotCount() && objects_.alive(ref.object));
+        const LocalBsp& bsp = objects_.model(objects_.modelOf(ref.object));
+        assert(ref.node < bsp.nodes.size());
+        whole.push_back({ref, bsp.nodes[ref.node].firstIndex, bsp.nodes[ref.node].indexCount});
+    }
+    return renderPartRanges(whole);
 }
 
 Expected<FrameStats> Engine::renderPartRanges(std::span<const PartRange> ranges) {
@@ -381,14 +374,15 @@ Expected<FrameStats> Engine::renderPartRanges(std::span<const PartRange> ranges)
             const NodeRef ref = ranges[i].part;
             assert(!ref.isSceneNode() && ref.object < objects_.slotCount() && objects_.alive(ref.object));
             partRanges.clear();
-            for (; i < ranges.size() && ranges[i].part == ref; ++i) {
-                partRanges.push_back({ranges[i].firstIndex, ranges[i].indexCount});
-                st.trianglesDrawn += ranges[i].indexCount / 3;
-            }
+            for (; i < ranges.size() && ranges[i].part == ref; ++i) partRanges.push_back({ranges[i].firstIndex, ranges[i].indexCount});
+            const LocalBspNode& n = objects_.model(objects_.modelOf(ref.object)).nodes[ref.node];
             if (sink.drawsRanges()) {
                 sink.drawPartRanges(ref, partRanges);
+                for (const IndexRange& r : partRanges) st.trianglesDrawn += r.indexCount / 3;
             } else {
-                for (const IndexRange& r : partRanges) sink.drawPart(ref, r.firstIndex, r.indexCount);
+                // A game's draw callback gets whole parts, as in renderFrame.
+                sink.drawPart(ref, n.firstIndex, n.indexCount);
+                st.trianglesDrawn += n.indexCount / 3;
             }
             ++st.partsDrawn;
         }

@@ -69,36 +69,29 @@ bool QueryScheduler::cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, 
     const glm::mat4& matrix = objs.matrix(ref.object);
     const std::span<const std::uint64_t> shown = split ? history_.clusterBits(ref.object, objs) : std::span<const std::uint64_t>{};
     const std::uint32_t firstCluster = model.clusters.nodeFirst[ref.node];
-    // The eye in the object's space (affine maps keep which side of a plane a point is on,
-    // mirroring included, as the rasteriser's facing follows the transformed winding).
-    const glm::dmat4 toObject = glm::inverse(glm::dmat4(matrix));
-    const bool ortho = f.camera().orthographic();
-    const glm::dvec3 eye = glm::dvec3(toObject * glm::dvec4(glm::dvec3(f.camera().position), 1.0));
-    const glm::dvec3 along = glm::dvec3(toObject * glm::dvec4(glm::dvec3(f.camera().forward()), 0.0));
+    const ObjectSpaceEye eye(f.camera(), matrix);
+    // What the tests culled (less the gaps drawn after all), what is left to the other
+    // pass, and what is drawn; gap*: the run of undrawn clusters since the last drawn one.
     std::uint64_t culledTriangles = 0, gapTriangles = 0, deferredTriangles = 0, drawnTriangles = 0;
     std::uint32_t culledClusters = 0, gapClusters = 0, deferred = 0, drawn = 0;
-    // Split passes never merge gaps: what their tests culled, apart from the other pass's clusters.
-    std::uint64_t splitCulledTriangles = 0;
-    std::uint32_t splitCulled = 0;
     for (std::uint32_t i = 0; i < clusters.size(); ++i) {
         const LeafCluster& c = clusters[i];
         // Deferred: drawn early already. Early: hidden last frame, left to the late pass
         // if it faces the eye and is in the frustum.
         const bool otherPass = split && bitSet(shown, firstCluster + i) == (pass == ClusterPass::Deferred);
         const bool drawnEarly = pass == ClusterPass::Deferred && otherPass;
-        bool culled = !drawnEarly && cones && (ortho ? c.backFacingAlong(along) : c.backFacingFrom(eye));
+        bool culled = !drawnEarly && cones && eye.backFacing(c);
         if (!drawnEarly && !culled && (frustum || pyramid)) culled = clusterHidden(f, pyramid ? &pyramid_ : nullptr, matrix, c, frustum);
-        if (culled && split) {
-            ++splitCulled;
-            splitCulledTriangles += c.indexCount / 3;
-        }
-        culled |= drawnEarly;
-        if (!culled && otherPass) {
-            ++deferred;
-            deferredTriangles += c.indexCount / 3;
-            culled = true;
-        }
         if (culled) {
+            ++culledClusters;
+            culledTriangles += c.indexCount / 3;
+        } else if (otherPass) {
+            if (!drawnEarly) {
+                ++deferred;
+                deferredTriangles += c.indexCount / 3;
+            }
+        }
+        if (culled || otherPass) {
             ++gapClusters;
             gapTriangles += c.indexCount / 3;
             continue;
@@ -111,16 +104,14 @@ bool QueryScheduler::cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, 
         IndexRange* last = clusterRanges_.empty() ? nullptr : &clusterRanges_.back();
         if (last && !split && double(gapTriangles) * params_.tuning.costs.drawNsPerTriangle < params_.tuning.costs.drawNsPerRange) {
             last->indexCount = c.firstIndex + c.indexCount - last->firstIndex;
+            culledClusters -= gapClusters;  // drawn after all (without a split every gap cluster was culled)
+            culledTriangles -= gapTriangles;
         } else {
             clusterRanges_.push_back({c.firstIndex, c.indexCount});
-            culledClusters += gapClusters;
-            culledTriangles += gapTriangles;
         }
         gapClusters = 0;
         gapTriangles = 0;
     }
-    culledClusters += gapClusters;  // after the last drawn one: costs no range
-    culledTriangles += gapTriangles;
     f.stats.clusterTests += static_cast<std::uint32_t>(clusters.size());
     lastDeferred_ = deferred;
     if (pass == ClusterPass::Early) {
@@ -130,14 +121,9 @@ bool QueryScheduler::cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, 
         f.stats.deferredClustersDrawn += drawn;
         deferredTriangles_ -= std::min(deferredTriangles_, drawnTriangles);
     }
-    if (split) {
-        f.stats.clustersCulled += splitCulled;
-        f.stats.clusterTrianglesCulled += splitCulledTriangles;
-    } else {
-        f.stats.clustersCulled += culledClusters;
-        f.stats.clusterTrianglesCulled += culledTriangles;
-        rate += 0.02 * (double(culledTriangles) / double(triangles > 0 ? triangles : 1) - rate);
-    }
+    f.stats.clustersCulled += culledClusters;
+    f.stats.clusterTrianglesCulled += culledTriangles;
+    if (!split) rate += 0.02 * (double(culledTriangles) / double(triangles > 0 ? triangles : 1) - rate);
     f.stats.clusterMs += msSince(t0);
     return true;
 }

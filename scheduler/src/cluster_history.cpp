@@ -50,7 +50,6 @@ void QueryScheduler::recordClusterVisibility(Frame& f) {
     if (!haveDepth) return;  // the bits stay as they were
     const auto t1 = SchedulerClock::now();
     const SceneObjects& objs = f.objects;
-    const bool ortho = f.camera().orthographic();
     for (const NodeRef ref : clusterParts_) {
         const LocalBsp& model = objs.model(objs.modelOf(ref.object));
         const std::span<const LeafCluster> clusters = model.clusters.ofSubtree(ref.node, model.nodes[ref.node].subtreeSize);
@@ -61,9 +60,7 @@ void QueryScheduler::recordClusterVisibility(Frame& f) {
         // A cluster facing away now is left to next frame's late pass, should it turn: the
         // cone test is cheaper than the projection.
         const bool cones = model.faces == FaceMode::CullBack && f.sink.cullsBackFaces();
-        const glm::dmat4 toObject = glm::inverse(glm::dmat4(matrix));
-        const glm::dvec3 eye = glm::dvec3(toObject * glm::dvec4(glm::dvec3(f.camera().position), 1.0));
-        const glm::dvec3 along = glm::dvec3(toObject * glm::dvec4(glm::dvec3(f.camera().forward()), 0.0));
+        const ObjectSpaceEye eye(f.camera(), matrix);
         for (std::uint32_t i = 0; i < clusters.size(); ++i) {
             const std::uint32_t k = first + i;
             const std::uint64_t bit = std::uint64_t{1} << (k & 63);
@@ -72,7 +69,7 @@ void QueryScheduler::recordClusterVisibility(Frame& f) {
             // the box is projected roughly: in float, without rounding margins.
             ScreenRect rect;
             float nearest = 1.0f;
-            const bool hidden = (cones && (ortho ? c.backFacingAlong(along) : c.backFacingFrom(eye))) ||
+            const bool hidden = (cones && eye.backFacing(c)) ||
                                 (f.screen.roughBoxDepth(toClip, c.box, rect, nearest) &&
                                  (rect.empty() || pyramid_.occluded(rect, nearest, kRecordSpan)));
             if (hidden) {

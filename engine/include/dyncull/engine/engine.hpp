@@ -157,7 +157,8 @@ public:
     /// The same with each part drawn as index ranges of its model's split mesh (the cluster
     /// oracle of `dyncull bench`): consecutive entries naming one part are its ranges,
     /// ascending, disjoint and inside the part's own range; the part counts once. Drawn in
-    /// one multi-draw where the part renderer draws, else range by range.
+    /// one multi-draw where the part renderer draws; a game's draw callback gets the whole
+    /// part, as in renderFrame.
     Expected<FrameStats> renderPartRanges(std::span<const PartRange> ranges);
     /// The parts the view's last frame drew (renderFrame/renderParts for the main view), in
     /// the order drawn (front to back within each pass); empty after a frame that returned
