@@ -195,7 +195,8 @@ const char* frameStatsCsvHeader() {
            "skipped_history,skipped_occupancy,skipped_cost,visible_near,visible_front,frustum_culled,small_feature_culled,"
            "nodes_visited,batches,parts,triangles,query_triangles,draw_queries,draw_queries_occluded,draw_queries_late,"
            "depth_tests,ms_depth_read,raster_tests,raster_batches,ms_raster,triangle_tests,ms_triangle_test,draw_marks_hidden,"
-           "cluster_tests,clusters_culled,cluster_triangles_culled,clusters_deferred,deferred_clusters_drawn,ms_clusters,budget_culled,claimed_error_pixels,claim_unbounded";
+           "cluster_tests,clusters_culled,cluster_triangles_culled,clusters_deferred,deferred_clusters_drawn,ms_clusters,budget_culled,claimed_error_pixels,claim_unbounded,"
+           "early_triangles,tested_triangles";
 }
 
 void writeFrameStatsCsv(std::ostream& f, const FrameStats& s) {
@@ -208,7 +209,7 @@ void writeFrameStatsCsv(std::ostream& f, const FrameStats& s) {
       << s.rasterTests << ',' << s.rasterBatches << ',' << s.rasterMs << ',' << s.triangleTests << ','
       << s.triangleTestMs << ',' << s.drawMarksHidden << ',' << s.clusterTests << ',' << s.clustersCulled << ','
       << s.clusterTrianglesCulled << ',' << s.clustersDeferred << ',' << s.deferredClustersDrawn << ',' << s.clusterMs << ',' << s.budgetCulled << ',' << s.claimedErrorPixels << ','
-      << (s.claimUnbounded ? 1 : 0);
+      << (s.claimUnbounded ? 1 : 0) << ',' << s.earlyTriangles << ',' << s.testedTriangles;
 }
 
 Status writeFramesCsv(const BenchResult& r, const fs::path& path) {

@@ -24,10 +24,10 @@ bool clusterHidden(const QueryScheduler::Frame& f, const DepthPyramid* pyramid, 
     const Aabb world = transformAabb(matrix, c.box);
     if (frustum && f.frustum().outside(world)) return true;
     if (!pyramid || world.contains(f.camera().position)) return false;
-    ScreenRect rect;
-    float nearest = 1.0f;
-    if (!f.screen.volumeDepth(QueryVolume::fromTransformedBox(matrix, c.box), rect, nearest)) return false;
-    return rect.empty() || pyramid->occluded(rect, nearest);
+    DepthFootprint fp;
+    if (!f.screen.volumeDepth(QueryVolume::fromTransformedBox(matrix, c.box), fp)) return false;
+    // A pyramid exists only for a single-sample target: a cluster covering no pixel centre draws nothing.
+    return fp.centres.empty() || pyramid->occluded(fp.centres, fp.nearest);
 }
 
 bool bitSet(std::span<const std::uint64_t> bits, std::uint32_t i) { return (bits[i >> 6] >> (i & 63)) & 1u; }

@@ -67,11 +67,11 @@ void QueryScheduler::recordClusterVisibility(Frame& f) {
             const LeafCluster& c = clusters[i];
             // No guarantee needed here (a deferred cluster is tested in the late pass), so
             // the box is projected roughly: in float, without rounding margins.
-            ScreenRect rect;
+            ScreenRect centres;
             float nearest = 1.0f;
             const bool hidden = (cones && eye.backFacing(c)) ||
-                                (f.screen.roughBoxDepth(toClip, c.box, rect, nearest) &&
-                                 (rect.empty() || pyramid_.occluded(rect, nearest, kRecordSpan)));
+                                (f.screen.roughBoxDepth(toClip, c.box, centres, nearest) &&
+                                 (centres.empty() || pyramid_.occluded(centres, nearest, kRecordSpan)));
             if (hidden) {
                 bits[k >> 6] &= ~bit;
             } else {

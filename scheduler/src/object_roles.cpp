@@ -65,13 +65,12 @@ void QueryScheduler::drawOccludees(Frame& f) {
             continue;
         }
         const QueryVolume volume = testedVolume(f, root);
-        ScreenRect rect;
-        float nearest = 1.0f;
-        if (!f.screen.volumeDepth(volume, rect, nearest) || box.contains(f.camera().position)) {
+        DepthFootprint fp;
+        if (!f.screen.volumeDepth(volume, fp) || box.contains(f.camera().position)) {
             ++f.stats.visibleNearOrInside;
             f.note(root, box, NodeState::VisibleNear);
             drawNode(f, root, false);
-        } else if (rect.empty()) {
+        } else if (fp.rect.empty()) {
             ++f.stats.frustumCulled;
             f.note(root, box, NodeState::FrustumCulled);
         } else {

@@ -73,13 +73,24 @@ ScreenRect ScreenProjection::pixelRect(const glm::dvec2& lo, const glm::dvec2& h
             clampi(std::ceil((hi.x + 1.0) * fx) + 1.0, view_.width), clampi(std::ceil((hi.y + 1.0) * fy) + 1.0, view_.height)};
 }
 
+ScreenRect ScreenProjection::centreRect(const glm::dvec2& lo, const glm::dvec2& hi) const {
+    // Pixel i's centre is at i + 0.5 in window coordinates. kSnap: a rasteriser snaps vertices
+    // to its sub-pixel grid, at least 4 bits in GL (SUBPIXEL_BITS), so by at most 1/32 pixel.
+    constexpr double kSnap = 1.0 / 16.0;
+    const double fx = 0.5 * view_.width, fy = 0.5 * view_.height;
+    auto clampi = [](double v, int lim) { return static_cast<int>(std::clamp(v, 0.0, static_cast<double>(lim))); };
+    return {clampi(std::ceil((lo.x + 1.0) * fx - 0.5 - kSnap), view_.width), clampi(std::ceil((lo.y + 1.0) * fy - 0.5 - kSnap), view_.height),
+            clampi(std::floor((hi.x + 1.0) * fx - 0.5 + kSnap) + 1.0, view_.width),
+            clampi(std::floor((hi.y + 1.0) * fy - 0.5 + kSnap) + 1.0, view_.height)};
+}
+
 glm::mat4 ScreenProjection::clipMatrixOf(const glm::mat4& matrix) const {
     glm::dmat4 relative(matrix);
     relative[3] -= glm::dvec4(glm::dvec3(view_.camera.position), 0.0);  // world minus the eye
     return glm::mat4(view_.viewProjRelative * relative);
 }
 
-bool ScreenProjection::roughBoxDepth(const glm::mat4& objectToClip, const Aabb& local, ScreenRect& rect, float& nearestDepth) const {
+bool ScreenProjection::roughBoxDepth(const glm::mat4& objectToClip, const Aabb& local, ScreenRect& centres, float& nearestDepth) const {
     glm::vec2 lo(1e30f), hi(-1e30f);
     float nearest = 0.0f;
     for (int i = 0; i < 8; ++i) {
@@ -93,12 +104,12 @@ bool ScreenProjection::roughBoxDepth(const glm::mat4& objectToClip, const Aabb& 
         hi = glm::max(hi, ndc);
         nearest = std::max(nearest, clip.z / clip.w);
     }
-    rect = pixelRect(glm::dvec2(lo), glm::dvec2(hi));
+    centres = centreRect(glm::dvec2(lo), glm::dvec2(hi));
     nearestDepth = nearest;
     return true;
 }
 
-bool ScreenProjection::volumeDepth(const QueryVolume& volume, ScreenRect& rect, float& nearestDepth) const {
+bool ScreenProjection::volumeDepth(const QueryVolume& volume, DepthFootprint& out) const {
     // The volume grown by the rounding of its float vertices, projected in double; any
     // point within the near-plane margin makes it "crossing" (visible), as in projectRect.
     std::array<glm::dvec3, QueryVolume::kMaxVertices> rel;
@@ -119,8 +130,9 @@ bool ScreenProjection::volumeDepth(const QueryVolume& volume, ScreenRect& rect, 
         hi = glm::max(hi, ndc);
         nearest = std::max(nearest, clip.z / clip.w);
     }
-    rect = pixelRect(lo, hi);
-    nearestDepth = static_cast<float>(nearest);
+    out.rect = pixelRect(lo, hi);
+    out.centres = centreRect(lo, hi);
+    out.nearest = static_cast<float>(nearest);
     return true;
 }
 

@@ -13,6 +13,18 @@
 
 namespace dyncull {
 
+/// A volume's screen footprint, as the depth-pyramid tests read it.
+struct DepthFootprint {
+    /// The pixels it can touch, rounded outwards and padded by one: right for any sample
+    /// pattern (a multisampled target's too).
+    ScreenRect rect;
+    /// The pixels whose centres it can cover: all of it that a single-sample depth buffer
+    /// holds, and so all the depth pyramid (built only from such buffers) needs. Empty if
+    /// it covers no pixel centre, and then it draws no fragment there.
+    ScreenRect centres;
+    float nearest = 1.0f;  ///< nearest window depth (reversed Z: the largest of its points')
+};
+
 /// Projects world-space boxes and volumes into one frame's viewport (pixels, origin at the
 /// lower left, as the occupancy maps and the depth pyramid count them). Borrows the view.
 class ScreenProjection {
@@ -24,21 +36,23 @@ public:
     /// may add), which makes it visible without a test. `out` is empty when nothing of the
     /// box is in front of the near plane or on screen.
     bool rect(const Aabb& box, ScreenRect& out) const;
-    /// A query volume's pixel rectangle and nearest window depth (reversed Z: the largest
-    /// of its points'), the volume grown by its vertices' rounding first; false if it
-    /// reaches the near plane (then it is simply visible).
-    bool volumeDepth(const QueryVolume& volume, ScreenRect& rect, float& nearestDepth) const;
+    /// A query volume's footprint (pixel rectangles and nearest depth), the volume grown by
+    /// its vertices' rounding first; false if it reaches the near plane (then it is simply
+    /// visible).
+    bool volumeDepth(const QueryVolume& volume, DepthFootprint& out) const;
     /// A guess, for choices that need no guarantee (cluster history's record of what
-    /// showed): the rectangle and nearest window depth of box `local` under
-    /// `objectToClip` (object space to clip space, camera-relative: clipMatrixOf), its 8
+    /// showed): the pixels whose centres box `local` under `objectToClip` (object space to
+    /// clip space, camera-relative: clipMatrixOf) covers and its nearest window depth, its 8
     /// corners projected in float with no rounding margins; false if a corner lies behind
     /// the near plane.
-    bool roughBoxDepth(const glm::mat4& objectToClip, const Aabb& local, ScreenRect& rect, float& nearestDepth) const;
+    bool roughBoxDepth(const glm::mat4& objectToClip, const Aabb& local, ScreenRect& centres, float& nearestDepth) const;
     /// Object space to clip space for an object whose object-to-world matrix is `matrix`,
     /// through the camera-relative view-projection (in double, then float).
     glm::mat4 clipMatrixOf(const glm::mat4& matrix) const;
     /// Normalised-device bounds [lo, hi] as viewport pixels, rounded outwards, padded by one.
     ScreenRect pixelRect(const glm::dvec2& lo, const glm::dvec2& hi) const;
+    /// The viewport pixels whose centres normalised-device bounds [lo, hi] can cover.
+    ScreenRect centreRect(const glm::dvec2& lo, const glm::dvec2& hi) const;
 
 private:
     /// The distance along the view direction of eye-relative point `rel` whose clip

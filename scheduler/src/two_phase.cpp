@@ -107,6 +107,7 @@ void QueryScheduler::runTwoPhase(Frame& f) {
 bool QueryScheduler::drawEarlySet(Frame& f) {
     // lastTouchedFrame marks a part drawn here.
     const std::uint32_t partsBefore = f.stats.partsDrawn;
+    const std::uint64_t trianglesBefore = f.stats.trianglesDrawn;
     while (!active_.empty()) {
         const NodeRef ref = active_.back();
         active_.pop_back();
@@ -123,6 +124,7 @@ bool QueryScheduler::drawEarlySet(Frame& f) {
             h.lastTouchedFrame = f.index;
         }
     }
+    f.stats.earlyTriangles += f.stats.trianglesDrawn - trianglesBefore;
     return f.stats.partsDrawn > partsBefore;
 }
 
@@ -150,12 +152,11 @@ void QueryScheduler::lateTraversal(Frame& f, bool testing, bool haveDepth, bool 
             note(NodeState::FrustumCulled);
             continue;
         }
-        ScreenRect rect;
-        float nearest = 1.0f;
         // Object nodes by their own volume (a transformed box or k-DOP, tighter than the
         // world box of a rotated part), scene nodes by their box; both grown by rounding.
-        const QueryVolume volume = testedVolume(f, ref);
-        const bool inFront = f.screen.volumeDepth(volume, rect, nearest);
+        DepthFootprint fp;
+        const bool inFront = f.screen.volumeDepth(testedVolume(f, ref), fp);
+        const ScreenRect& rect = fp.rect;
         bool certain = false;  // visible without any test (near plane, camera inside)
         if (!inFront || box.contains(f.camera().position)) {
             ++f.stats.visibleNearOrInside;
@@ -167,7 +168,9 @@ void QueryScheduler::lateTraversal(Frame& f, bool testing, bool haveDepth, bool 
             continue;
         } else if (haveDepth) {
             ++f.stats.depthTests;
-            if (pyramid_.occluded(rect, nearest)) {
+            // The pyramid exists only for a single-sample target, where a volume that covers
+            // no pixel centre draws nothing.
+            if (fp.centres.empty() || pyramid_.occluded(fp.centres, fp.nearest)) {
                 ++f.stats.queriesOccluded;
                 culledTriangles_ += subtreeTriangles(f, ref);
                 history_.recordAnswer(h, false, f.index);
@@ -250,6 +253,7 @@ void QueryScheduler::testCandidates(Frame& f, bool triangles) {
 
 void QueryScheduler::settleCandidates(Frame& f, bool triangles) {
     const SceneObjects& objs = f.objects;
+    const std::uint64_t trianglesBefore = f.stats.trianglesDrawn;
     for (std::size_t i = 0; i < candidates_.size(); ++i) {
         const NodeRef ref = candidates_[i];
         NodeHistory& h = history_.at(ref, objs);
@@ -274,6 +278,7 @@ void QueryScheduler::settleCandidates(Frame& f, bool triangles) {
             if (!triangles) refresh_.push_back(candidates_[i]);  // may be hidden by parts drawn after it
         }
     }
+    f.stats.testedTriangles += f.stats.trianglesDrawn - trianglesBefore;
 }
 
 void QueryScheduler::testRefresh(Frame& f) {

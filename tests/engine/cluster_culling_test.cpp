@@ -164,5 +164,26 @@ TEST_F(ClusterHistory, EarlyPartsDrawOnlyWhatShowedAndTheImageStaysExact) {
     EXPECT_LT(drawnHistory, drawnWhole);
 }
 
+TEST_F(ClusterCulling, PixelSizedClustersKeepTheImageExact) {
+    // Spheres of one to a few pixels, so that most clusters cover a pixel centre or two, or
+    // none: the depth-pyramid tests read only the pixels whose centres a box can cover
+    // (DepthFootprint::centres), and call a box that covers none hidden. Every frame, with the
+    // camera circling (so the boxes slide across pixel centres), two-phase with clusters draws
+    // vfc's image.
+    build({600, 40, 4.0f, 0.04f, {2.5f, 2.0f, 2.5f}});
+    if (HasFatalFailure()) return;
+    QueryScheduler twoPhase(paramsOf(CullMode::TwoPhase, true)), vfc(paramsOf(CullMode::Vfc, false));
+    std::uint64_t culled = 0;
+    for (int f = 0; f < 16; ++f) {
+        circle(0.05f * float(f), 9.0f, 1.0f + 0.013f * float(f));
+        Image images[2];
+        culled += render(twoPhase, images[0]).clusterTrianglesCulled;
+        render(vfc, images[1]);
+        EXPECT_EQ(differingPixels(images[0], images[1]), 0u) << "frame " << f;
+    }
+    EXPECT_EQ(ctx_->checkErrors(), 0u);
+    EXPECT_GT(culled, 0u);
+}
+
 }  // namespace
 }  // namespace dyncull

@@ -60,6 +60,11 @@ struct FrameStats {
     /// none of whose clusters survived is not drawn and not counted.
     std::uint32_t partsDrawn = 0;
     std::uint64_t trianglesDrawn = 0;
+    /// Two-phase: of trianglesDrawn, those of the early pass, and those of the parts drawn
+    /// after the batched raster test let them through (the rest the late pass drew untested,
+    /// and the early parts' deferred clusters).
+    std::uint64_t earlyTriangles = 0;
+    std::uint64_t testedTriangles = 0;
 };
 
 }  // namespace dyncull
