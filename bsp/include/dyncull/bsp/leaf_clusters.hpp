@@ -26,11 +26,13 @@ namespace dyncull {
 
 struct LocalBspNode;
 
-/// The size of a cluster: meshoptimizer's recommended meshlet limits for GPUs (64 vertices,
-/// 124 triangles, as in niagara). Small enough that a cluster's normals usually share a
-/// half-space, large enough that a test costs a small fraction of drawing it.
-inline constexpr std::uint32_t kClusterMaxVertices = 64;
-inline constexpr std::uint32_t kClusterMaxTriangles = 124;
+/// The size of a cluster: half meshoptimizer's recommended meshlet limits for GPUs (64
+/// vertices, 124 triangles, as in niagara), since on a CPU rasteriser the triangles a
+/// tighter box or normal cone saves outweigh the extra per-cluster tests (measured on the
+/// swarm at 16/32, 32/64 and 64/124 in docs/BENCHMARKS.md). A multiple of 4 triangles, as
+/// meshopt_buildMeshlets requires.
+inline constexpr std::uint32_t kClusterMaxVertices = 32;
+inline constexpr std::uint32_t kClusterMaxTriangles = 64;
 
 /// One cluster: triangles [firstIndex, firstIndex + indexCount) of the split mesh, all in
 /// one leaf. Object space, like the mesh.
