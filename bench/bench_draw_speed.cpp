@@ -267,11 +267,17 @@ struct Swarm {
         p.mode = CullMode::Vfc;
         return p;
     }()};
-    /// The default conservative mode (two-phase), and the same with early parts drawn whole.
+    /// The default conservative mode (two-phase), the same with early parts drawn whole, and
+    /// with the early clusters chosen by their fragments' marks instead of their boxes.
     QueryScheduler full{SchedulerParams{}};
     QueryScheduler fullNoClusterHistory{[] {
         SchedulerParams p;
         p.features.useClusterHistory = false;
+        return p;
+    }()};
+    QueryScheduler fullMarkClusterHistory{[] {
+        SchedulerParams p;
+        p.features.useClusterMarks = true;
         return p;
     }()};
 };
@@ -430,6 +436,8 @@ int main(int argc, char** argv) {
                         cullFrame(tuned, tuned.full), {}, 0, {}});
     variants.push_back({"full-noclusterhist", "full with early parts drawn with all their clusters",
                         cullFrame(tuned, tuned.fullNoClusterHistory), {}, 0, {}});
+    variants.push_back({"full-markclusterhist", "full with the early clusters chosen by their fragments' marks, not by their boxes",
+                        cullFrame(tuned, tuned.fullMarkClusterHistory), {}, 0, {}});
     variants.push_back({"vfc-before", "the renderer before issue 21: per-pixel, two-sided, load order, whole parts",
                         vfcFrame(unordered, Shading::Pixel, false, false, false), {}, 0, {}});
 

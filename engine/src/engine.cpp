@@ -16,7 +16,8 @@ namespace dyncull {
 struct Engine::Sink final : PartSink {
     Engine& e;
     VisibleLists& visible;
-    bool marking = false;
+    bool marking = false;        // every draw marks one slot (beginDrawMarks)
+    bool markingRanges = false;  // every range of drawPartRanges and drawMorePartRanges marks one (beginRangeMarks)
     Sink(Engine& engine, VisibleLists& lists) : e(engine), visible(lists) {}
     void record(NodeRef part, std::uint32_t firstIndex, std::uint32_t indexCount) {
         const SceneObjects& objs = e.objects_;
@@ -36,7 +37,7 @@ struct Engine::Sink final : PartSink {
             return;
         }
         const IndexRange range{firstIndex, indexCount};
-        render(part, {&range, 1});
+        render(part, {&range, 1}, false);
     }
     bool drawsRanges() const override { return !e.callback_ && e.renderer_; }
     bool cullsBackFaces() const override { return !e.callback_ && e.renderer_ && e.renderer_->backFaceCulling(); }
@@ -45,25 +46,30 @@ struct Engine::Sink final : PartSink {
         // The part is visible as a whole: the game's lists get its whole range.
         const LocalBspNode& n = e.objects_.model(e.objects_.modelOf(part.object)).nodes[part.node];
         record(part, n.firstIndex, n.indexCount);
-        render(part, ranges);
+        render(part, ranges, markingRanges);
     }
-    void drawMorePartRanges(NodeRef part, std::span<const IndexRange> ranges) override { render(part, ranges); }
-    // The part renderer's draw of `ranges` of `part`, marked while marking.
-    void render(NodeRef part, std::span<const IndexRange> ranges) {
+    void drawMorePartRanges(NodeRef part, std::span<const IndexRange> ranges) override { render(part, ranges, markingRanges); }
+    // The part renderer's draw of `ranges` of `part`: one mark for the draw while marking
+    // draws, one per range if `markEachRange`.
+    void render(NodeRef part, std::span<const IndexRange> ranges, bool markEachRange) {
         const SceneObjects& objs = e.objects_;
         const std::uint32_t object = part.object;
+        const std::uint32_t slots = marking ? 1u : markEachRange ? static_cast<std::uint32_t>(ranges.size()) : 0u;
+        const MeshId mesh = e.meshOfModel_[objs.modelOf(object)];
+        if (mesh == kNoMesh) {  // a bounds model only the draw callback draws
+            if (slots > 0) e.marks_->skipDrawSlots(slots);
+            return;
+        }
         const glm::vec3 colour = object < e.hasColour_.size() && e.hasColour_[object] ? e.colour_[object] : colourForId(object);
-        const std::uint32_t markSlot = marking ? e.marks_->nextDrawSlot() : Renderer::kNoMark;
+        const std::uint32_t markSlot = slots > 0 ? e.marks_->nextDrawSlots(slots) : Renderer::kNoMark;
         // An occludee-only object occludes nothing: drawn without depth writes (after
         // everything that occludes, as the scheduler orders it).
         const bool occludee = objs.role(object) == OcclusionRole::OccludeeOnly;
         if (occludee) glDepthMask(GL_FALSE);
-        const MeshId mesh = e.meshOfModel_[objs.modelOf(object)];
-        if (mesh == kNoMesh) return;  // a bounds model only the draw callback draws
         if (ranges.size() == 1)
             e.renderer_->drawRange(mesh, ranges[0].firstIndex, ranges[0].indexCount, objs.matrix(object), colour, markSlot);
         else
-            e.renderer_->drawRanges(mesh, ranges, objs.matrix(object), colour, markSlot);
+            e.renderer_->drawRanges(mesh, ranges, objs.matrix(object), colour, markSlot, markEachRange && markSlot != Renderer::kNoMark);
         if (occludee) glDepthMask(GL_TRUE);
     }
     bool testsTriangles() const override { return !e.callback_ && e.renderer_ && e.marks_; }
@@ -75,6 +81,17 @@ struct Engine::Sink final : PartSink {
     void readDrawMarks(std::span<QueryResult> out) override {
         assert(marking && out.size() == e.marks_->drawCount());
         e.marks_->readDraws(out);
+    }
+    bool marksRanges() const override { return drawsRanges() && e.marks_ && e.renderer_->supportsRangeMarks(); }
+    void beginRangeMarks() override {
+        assert(marksRanges() && !marking);
+        e.marks_->beginDraws();
+        markingRanges = true;
+    }
+    void readRangeMarks(std::span<QueryResult> out) override {
+        assert(markingRanges && out.size() == e.marks_->drawCount());
+        e.marks_->readDraws(out);
+        markingRanges = false;
     }
     void testParts(std::span<const PartRange> parts, std::span<QueryResult> out) override {
         assert(testsTriangles() && out.size() == parts.size());

@@ -58,13 +58,24 @@ void PartMarks::beginDraws() {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kMarksBinding, draws_.name);
 }
 
-std::uint32_t PartMarks::nextDrawSlot() {
-    const std::uint32_t slot = draws_.count++;
-    const bool grown = slot < draws_.capacity || reserve(draws_, slot + 1, true);
-    draws_.unmarked.push_back(grown ? 0 : 1);
-    if (!grown) return Renderer::kNoMark;
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kMarksBinding, draws_.name);  // a grown buffer is a new name
+std::uint32_t PartMarks::nextDrawSlots(std::uint32_t count) {
+    assert(count > 0);
+    const std::uint32_t slot = draws_.count;
+    // Each slot is a draw or a drawn cluster, so a frame holds far fewer than 2^32.
+    assert(count < Renderer::kNoMark - slot);
+    draws_.count += count;
+    const bool fits = draws_.count <= draws_.capacity;
+    const bool grown = !fits && reserve(draws_, draws_.count, true);
+    draws_.unmarked.insert(draws_.unmarked.end(), count, fits || grown ? 0 : 1);
+    if (!fits && !grown) return Renderer::kNoMark;
+    if (grown) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kMarksBinding, draws_.name);  // a grown buffer is a new name
     return slot;
+}
+
+void PartMarks::skipDrawSlots(std::uint32_t count) {
+    assert(count < Renderer::kNoMark - draws_.count);
+    draws_.count += count;
+    draws_.unmarked.insert(draws_.unmarked.end(), count, 1);
 }
 
 void PartMarks::read(Buffer& b, std::span<QueryResult> out) {

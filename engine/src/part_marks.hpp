@@ -30,12 +30,16 @@ public:
     /// Starts marking the draws of a frame: the draw buffer, cleared, is bound at
     /// kMarksBinding. Every earlier draw mark is forgotten.
     void beginDraws();
-    /// The slot of the next marked draw (0, 1, 2, ... since beginDraws). The buffer grows,
-    /// keeping the marks already stored, when the frame draws more than it holds; a slot it
-    /// could not grow to is kNoMark (the draw is then unmarked and answered Visible).
-    std::uint32_t nextDrawSlot();
-    /// The draws marked since beginDraws, in order: Visible if a fragment passed the depth
-    /// test when drawn, else Occluded (waits for the drawing). `out` holds one per draw.
+    /// The first of the next `count` slots (0, 1, 2, ... since beginDraws): one for a
+    /// marked draw, one per range for a draw that marks each range. The buffer grows,
+    /// keeping the marks already stored, when the frame draws more than it holds; slots it
+    /// could not grow to give kNoMark (the draw is then unmarked, its slots answered Visible).
+    std::uint32_t nextDrawSlots(std::uint32_t count = 1);
+    /// Takes `count` slots for a draw the part renderer cannot make (a bounds model only the
+    /// game's callback draws): answered Visible, since nothing says they are hidden.
+    void skipDrawSlots(std::uint32_t count);
+    /// The slots marked since beginDraws, in order: Visible if a fragment passed the depth
+    /// test when drawn, else Occluded (waits for the drawing). `out` holds one per slot.
     void readDraws(std::span<QueryResult> out);
     std::uint32_t drawCount() const { return draws_.count; }
 

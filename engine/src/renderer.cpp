@@ -21,12 +21,21 @@ Expected<std::unique_ptr<Renderer>> Renderer::create(GlContext& context) {
     const char* const sources[2][2] = {{detail::kVertexLitVertexShader, detail::kVertexLitFragmentShader},
                                        {detail::kLitVertexShader, detail::kLitFragmentShader}};
     static_assert(static_cast<int>(Shading::Vertex) == 0 && static_cast<int>(Shading::Pixel) == 1);
+    using detail::MarkKind;
+    // Marks per range need the draw's range index in the shader (core only from GL 4.6).
+    r->rangeMarks_ = epoxy_gl_version() >= 46 || epoxy_has_gl_extension("GL_ARB_shader_draw_parameters");
     for (int i = 0; i < 2; ++i) {
-        for (int marking = 0; marking < 2; ++marking) {
+        for (const MarkKind marks : {MarkKind::None, MarkKind::Draw, MarkKind::Range}) {
+            if (marks == MarkKind::Range && !r->rangeMarks_) continue;
             std::string log;
-            LitProgram& p = r->programs_[i][marking];
-            const std::string fragment = detail::litFragmentSource(sources[i][1], marking == 1);
-            p.id = detail::buildProgram(sources[i][0], fragment.c_str(), log);
+            LitProgram& p = r->programs_[i][static_cast<int>(marks)];
+            const std::string vertex = detail::litVertexSource(sources[i][0], marks);
+            const std::string fragment = detail::litFragmentSource(sources[i][1], marks);
+            p.id = detail::buildProgram(vertex.c_str(), fragment.c_str(), log);
+            if (!p.id && marks == MarkKind::Range) {  // an extension listed but not compiled: do without
+                r->rangeMarks_ = false;
+                continue;
+            }
             if (!p.id) return Error{"renderer: lit shader rejected by " + context.rendererName() + ": " + log};
             p.viewProj = glGetUniformLocation(p.id, "uViewProj");
             p.model = glGetUniformLocation(p.id, "uModel");
@@ -38,7 +47,7 @@ Expected<std::unique_ptr<Renderer>> Renderer::create(GlContext& context) {
         }
     }
     std::string log;
-    const std::string testFragment = detail::litFragmentSource(detail::kTriangleTestFragmentShader, true);
+    const std::string testFragment = detail::litFragmentSource(detail::kTriangleTestFragmentShader, detail::MarkKind::Draw);
     TestProgram& t = r->testProgram_;
     t.id = detail::buildProgram(detail::kTriangleTestVertexShader, testFragment.c_str(), log);
     if (!t.id) return Error{"renderer: triangle-test shader rejected by " + context.rendererName() + ": " + log};
@@ -57,7 +66,7 @@ Renderer::~Renderer() {
     }
     for (const auto& variants : programs_)
         for (const LitProgram& p : variants)
-            if (p.id) glDeleteProgram(p.id);
+            if (p.id) glDeleteProgram(p.id);  // 0: a variant not built
     if (testProgram_.id) glDeleteProgram(testProgram_.id);
 }
 
@@ -157,6 +166,7 @@ void Renderer::beginFrame(const FrameView& view) {
     // direction for an orthographic camera, whose eye is at infinity.
     const glm::vec4 viewer = camera.orthographic() ? glm::vec4(-camera.forward(), 0.0f) : glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
     for (const LitProgram& p : programs_[static_cast<int>(shading_)]) {
+        if (!p.id) continue;
         glUseProgram(p.id);
         glUniformMatrix4fv(p.viewProj, 1, GL_FALSE, glm::value_ptr(viewProjRel));
         glUniform4fv(p.viewer, 1, glm::value_ptr(viewer));
@@ -166,13 +176,17 @@ void Renderer::beginFrame(const FrameView& view) {
     glUniformMatrix4fv(testProgram_.viewProj, 1, GL_FALSE, glm::value_ptr(viewProjRel));
 }
 
-void Renderer::bindDraw(const GpuMesh& g, const glm::mat4& model, const glm::vec3& colour, std::uint32_t markSlot) {
+void Renderer::bindDraw(const GpuMesh& g, const glm::mat4& model, const glm::vec3& colour, std::uint32_t markSlot,
+                        bool markEachRange) {
     // Inverse-transpose keeps normals perpendicular under non-uniform scale; done once per
     // draw on the CPU instead of per vertex.
     const glm::mat3 linear(model);
     const glm::mat3 normalMat = glm::inverseTranspose(linear);
     detail::setFaceCulling(cullEnabled_, frontCcw_, g.cullBack && cullBackFaces_, linear);
-    const LitProgram& p = programs_[static_cast<int>(shading_)][markSlot != kNoMark];
+    const detail::MarkKind marks = markSlot == kNoMark ? detail::MarkKind::None
+                                   : markEachRange    ? detail::MarkKind::Range
+                                                      : detail::MarkKind::Draw;
+    const LitProgram& p = programs_[static_cast<int>(shading_)][static_cast<int>(marks)];
     glUseProgram(p.id);
     if (markSlot != kNoMark) glUniform1ui(p.markSlot, markSlot);
     const glm::mat4 relative = camera_.relativeModel(model);
@@ -190,7 +204,7 @@ void Renderer::drawRange(MeshId id, std::uint32_t firstIndex, std::uint32_t coun
     const GpuMesh& g = meshes_[id];
     assert(firstIndex <= g.indexCount && count <= g.indexCount - firstIndex);
     if (count == 0) return;
-    bindDraw(g, model, colour, markSlot);
+    bindDraw(g, model, colour, markSlot, false);
     glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(count), GL_UNSIGNED_INT,
                    reinterpret_cast<const void*>(static_cast<std::uintptr_t>(firstIndex) * sizeof(std::uint32_t)));
     ++stats_.drawCalls;
@@ -198,7 +212,8 @@ void Renderer::drawRange(MeshId id, std::uint32_t firstIndex, std::uint32_t coun
 }
 
 void Renderer::drawRanges(MeshId id, std::span<const IndexRange> ranges, const glm::mat4& model, const glm::vec3& colour,
-                          std::uint32_t markSlot) {
+                          std::uint32_t markSlot, bool markEachRange) {
+    assert(!markEachRange || (rangeMarks_ && markSlot != kNoMark));
     assert(id < meshes_.size());
     const GpuMesh& g = meshes_[id];
     if (ranges.empty()) return;
@@ -210,7 +225,7 @@ void Renderer::drawRanges(MeshId id, std::span<const IndexRange> ranges, const g
         multiOffsets_.push_back(reinterpret_cast<const void*>(static_cast<std::uintptr_t>(r.firstIndex) * sizeof(std::uint32_t)));
         stats_.triangles += r.indexCount / 3;
     }
-    bindDraw(g, model, colour, markSlot);
+    bindDraw(g, model, colour, markSlot, markEachRange);
     glMultiDrawElements(GL_TRIANGLES, multiCounts_.data(), GL_UNSIGNED_INT, multiOffsets_.data(),
                         static_cast<GLsizei>(ranges.size()));
     ++stats_.drawCalls;

@@ -16,6 +16,7 @@ namespace dyncull::detail {
 // display gamma is separable, pow(c * i, g) = pow(c, g) * pow(i, g), so the colour's part
 // is a uniform (uColour is given already raised to 1 / 1.2 by the renderer).
 const char* const kVertexLitVertexShader = R"(#version 450 core
+DYNCULL_RANGE_DECLARATION
 layout(location = 0) in vec3 aPosition;
 layout(location = 1) in vec3 aNormal;
 uniform mat4 uViewProj;
@@ -34,6 +35,7 @@ void main() {
     float key = max(dot(n, uLightDir), 0.0);
     float hemi = 0.5 + 0.5 * n.y;
     vIntensity = pow(0.18 + 0.12 * hemi + 0.55 * key + 0.22 * nv * nv, 1.0 / 1.2);
+    DYNCULL_RANGE;
 }
 )";
 
@@ -50,6 +52,7 @@ void main() {
 
 // Per-pixel lighting (Shading::Pixel): the same terms evaluated per fragment.
 const char* const kLitVertexShader = R"(#version 450 core
+DYNCULL_RANGE_DECLARATION
 layout(location = 0) in vec3 aPosition;
 layout(location = 1) in vec3 aNormal;
 uniform mat4 uViewProj;
@@ -63,6 +66,7 @@ void main() {
     vWorldPos = world.xyz;
     vNormal = uNormalMat * aNormal;
     gl_Position = uViewProj * world;
+    DYNCULL_RANGE;
 }
 )";
 
@@ -88,25 +92,49 @@ void main() {
 )";
 
 // Marks (renderer.hpp, Renderer::drawRange's `markSlot`): the variant of a lit fragment
-// shader that also records whether its part drew a sample that passed the depth test. With
+// shader that also records whether its draw drew a sample that passed the depth test. With
 // early depth testing only passing fragments run, so a store means a visible sample; the
 // shaders neither discard nor write depth, so testing early changes no pixel. The plain
-// variant leaves both placeholders out.
+// variant leaves the placeholders out. Marks per range (MarkKind::Range) give each range
+// of a multi-draw its own slot: the vertex stage hands the range's index in the draw
+// (gl_DrawIDARB, ARB_shader_draw_parameters, core in GL 4.6) to the fragment stage, flat.
 const char* const kMarksDeclaration = R"(
 layout(early_fragment_tests) in;
 layout(std430, binding = 1) writeonly buffer Marks { uint marks[]; };
 uniform uint uMarkSlot;
 )";
 const char* const kMarkStatement = "marks[uMarkSlot] = 1u";
+namespace {
+const char* const kRangeMarksDeclaration = R"(
+layout(early_fragment_tests) in;
+layout(std430, binding = 1) writeonly buffer Marks { uint marks[]; };
+uniform uint uMarkSlot;
+flat in uint vRange;
+)";
+const char* const kRangeMarkStatement = "marks[uMarkSlot + vRange] = 1u";
+const char* const kRangeVertexDeclaration = R"(#extension GL_ARB_shader_draw_parameters : require
+flat out uint vRange;
+)";
+const char* const kRangeVertexStatement = "vRange = uint(gl_DrawIDARB)";
 
-std::string litFragmentSource(const char* source, bool marking) {
+void fill(std::string& s, std::string_view placeholder, std::string_view text) {
+    const std::size_t at = s.find(placeholder);
+    if (at != std::string::npos) s.replace(at, placeholder.size(), text);
+}
+}  // namespace
+
+std::string litFragmentSource(const char* source, MarkKind marks) {
     std::string s(source);
-    auto fill = [&s](std::string_view placeholder, std::string_view text) {
-        const std::size_t at = s.find(placeholder);
-        if (at != std::string::npos) s.replace(at, placeholder.size(), text);
-    };
-    fill("DYNCULL_MARKS_DECLARATION", marking ? kMarksDeclaration : "");  // first: DYNCULL_MARK is its prefix
-    fill("DYNCULL_MARK", marking ? kMarkStatement : "");
+    // The declaration first: DYNCULL_MARK is its prefix.
+    fill(s, "DYNCULL_MARKS_DECLARATION", marks == MarkKind::Draw ? kMarksDeclaration : marks == MarkKind::Range ? kRangeMarksDeclaration : "");
+    fill(s, "DYNCULL_MARK", marks == MarkKind::Draw ? kMarkStatement : marks == MarkKind::Range ? kRangeMarkStatement : "");
+    return s;
+}
+
+std::string litVertexSource(const char* source, MarkKind marks) {
+    std::string s(source);
+    fill(s, "DYNCULL_RANGE_DECLARATION", marks == MarkKind::Range ? kRangeVertexDeclaration : "");
+    fill(s, "DYNCULL_RANGE", marks == MarkKind::Range ? kRangeVertexStatement : "");
     return s;
 }
 

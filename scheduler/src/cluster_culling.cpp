@@ -35,6 +35,7 @@ bool bitSet(std::span<const std::uint64_t> bits, std::uint32_t i) { return (bits
 
 bool QueryScheduler::cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, const LocalBspNode& n, ClusterPass pass) {
     clusterRanges_.clear();
+    clusterRangeIds_.clear();
     lastDeferred_ = 0;
     if (!params_.features.useClusters || ref.isSceneNode() || !f.sink.drawsRanges() || !model.clusters.builtFor(model.nodes.size()))
         return false;
@@ -44,9 +45,9 @@ bool QueryScheduler::cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, 
     if (f.recordClusterBits && pass != ClusterPass::Deferred) clusterParts_.push_back(ref);  // its bits are written at the frame's end
     // Which tests can cull anything here: cones only where back faces are culled, the
     // frustum only for a part crossing it, the pyramid only after the early pass.
-    const bool cones = model.faces == FaceMode::CullBack && f.sink.cullsBackFaces();
-    const bool frustum = f.frustum().classify(f.tree.worldBox(ref)) != Frustum::Side::Inside;
-    const bool pyramid = f.clusterPyramid;
+    bool cones = model.faces == FaceMode::CullBack && f.sink.cullsBackFaces();
+    bool frustum = f.frustum().classify(f.tree.worldBox(ref)) != Frustum::Side::Inside;
+    bool pyramid = f.clusterPyramid;
     // With cluster history the early pass draws the clusters that showed last frame and
     // the late pass the others: a split no cost model may turn off.
     const bool split = pass != ClusterPass::All;
@@ -54,15 +55,18 @@ bool QueryScheduler::cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, 
     if (clusterCulledRate_.size() <= modelId) clusterCulledRate_.resize(modelId + 1, 0.5);
     double& rate = clusterCulledRate_[modelId];
     const std::uint32_t triangles = n.indexCount / 3;
+    bool tested = split;
     if (!split) {
-        if (!cones && !frustum && !pyramid) return false;
-        if (!cones && !pyramid && clusters.size() == 1) return false;  // the part's own frustum test said it all
         // The cost model: a model's clusters are tested while the drawing they were
         // measured to save (its rate of culled triangles) exceeds the tests' cost; one
         // part in eight is tested regardless, so the rate stays measured.
-        if (params_.features.useCostModel && !exploring(ref) &&
-            rate * triangles * params_.tuning.costs.drawNsPerTriangle < double(clusters.size()) * params_.tuning.costs.clusterTestNs)
-            return false;
+        tested = (cones || frustum || pyramid) &&
+                 (cones || pyramid || clusters.size() > 1) &&  // else the part's own frustum test said it all
+                 (!params_.features.useCostModel || exploring(ref) ||
+                  rate * triangles * params_.tuning.costs.drawNsPerTriangle >= double(clusters.size()) * params_.tuning.costs.clusterTestNs);
+        // Untested, it is drawn whole; unless its clusters are marked, which needs them apart.
+        if (!tested && !f.markClusters) return false;
+        if (!tested) cones = frustum = pyramid = false;
     }
 
     const auto t0 = SchedulerClock::now();
@@ -102,17 +106,18 @@ bool QueryScheduler::cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, 
         // multi-draw: skipped only where it saves more drawing than a range costs, and
         // always when it holds clusters the other pass draws.
         IndexRange* last = clusterRanges_.empty() ? nullptr : &clusterRanges_.back();
-        if (last && !split && double(gapTriangles) * params_.tuning.costs.drawNsPerTriangle < params_.tuning.costs.drawNsPerRange) {
+        if (last && !split && !f.markClusters && double(gapTriangles) * params_.tuning.costs.drawNsPerTriangle < params_.tuning.costs.drawNsPerRange) {
             last->indexCount = c.firstIndex + c.indexCount - last->firstIndex;
             culledClusters -= gapClusters;  // drawn after all (without a split every gap cluster was culled)
             culledTriangles -= gapTriangles;
         } else {
             clusterRanges_.push_back({c.firstIndex, c.indexCount});
+            if (f.markClusters) clusterRangeIds_.push_back(firstCluster + i);
         }
         gapClusters = 0;
         gapTriangles = 0;
     }
-    f.stats.clusterTests += static_cast<std::uint32_t>(clusters.size());
+    if (tested) f.stats.clusterTests += static_cast<std::uint32_t>(clusters.size());
     lastDeferred_ = deferred;
     if (pass == ClusterPass::Early) {
         f.stats.clustersDeferred += deferred;
@@ -123,7 +128,7 @@ bool QueryScheduler::cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, 
     }
     f.stats.clustersCulled += culledClusters;
     f.stats.clusterTrianglesCulled += culledTriangles;
-    if (!split) rate += 0.02 * (double(culledTriangles) / double(triangles > 0 ? triangles : 1) - rate);
+    if (!split && tested) rate += 0.02 * (double(culledTriangles) / double(triangles > 0 ? triangles : 1) - rate);
     f.stats.clusterMs += msSince(t0);
     return true;
 }

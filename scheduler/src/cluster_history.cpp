@@ -1,11 +1,14 @@
 // Cluster history: TwoPhase's early set kept per cluster, as niagara keeps a visibility bit
 // per meshlet for its two-phase culling (the scheme in
-// ../shared/notes/batched-occlusion-tests.md: visibility stored for the next frame). At a
-// frame's end the final depth is read back into the pyramid and every cluster of the parts
-// drawn is tested against it; next frame an early part draws only the clusters that showed,
-// and the late pass tests the others against the early pyramid (cluster_culling.cpp). The
-// bits only choose what is drawn early, so a wrong bit costs time, never a pixel.
+// ../shared/notes/batched-occlusion-tests.md: visibility stored for the next frame). A
+// cluster's bit is whether any of its fragments passed the depth test when it was drawn
+// (the sink marks each range of its multi-draws), or, where the sink cannot mark, whether
+// its box shows in the frame's final depth, read back into the pyramid at its end. Next
+// frame an early part draws only the clusters that showed, and the late pass tests the
+// others against the early pyramid (cluster_culling.cpp). The bits only choose what is
+// drawn early, so a wrong bit costs time, never a pixel.
 #include <algorithm>
+#include <cassert>
 
 #include "cull_frame.hpp"
 
@@ -34,6 +37,7 @@ void QueryScheduler::drawDeferredClusters(Frame& f) {
             f.sink.drawPartRanges(d.ref, clusterRanges_);
             ++f.stats.partsDrawn;
         }
+        if (f.markClusters) noteMarkedRanges(d.ref);
         f.stats.drawMs += msSince(t0);
         for (const IndexRange& r : clusterRanges_) f.stats.trianglesDrawn += r.indexCount / 3;
     }
@@ -81,6 +85,35 @@ void QueryScheduler::recordClusterVisibility(Frame& f) {
     }
     f.stats.clusterMs += msSince(t1);
     clusterRecordNs_ = 1e6 * msSince(t0);
+    lastClusterRecordFrame_ = f.index;
+}
+
+void QueryScheduler::noteMarkedRanges(NodeRef ref) {
+    assert(clusterRangeIds_.size() == clusterRanges_.size());
+    for (const std::uint32_t k : clusterRangeIds_) markedClusters_.push_back({ref.object, k});
+}
+
+void QueryScheduler::readClusterMarks(Frame& f) {
+    const auto t0 = SchedulerClock::now();
+    clusterMarks_.assign(markedClusters_.size(), QueryResult::Visible);
+    f.sink.readRangeMarks(clusterMarks_);
+    const SceneObjects& objs = f.objects;
+    // A recorded part's clusters not drawn this frame (facing away, outside the frustum,
+    // behind the pyramid) are left to next frame's late pass, as those drawn and hidden.
+    for (const NodeRef ref : clusterParts_) {
+        const LocalBsp& model = objs.model(objs.modelOf(ref.object));
+        const std::span<std::uint64_t> bits = history_.clusterBits(ref.object, objs);
+        const std::uint32_t first = model.clusters.nodeFirst[ref.node];
+        const std::uint32_t end = first + static_cast<std::uint32_t>(model.clusters.ofSubtree(ref.node, model.nodes[ref.node].subtreeSize).size());
+        for (std::uint32_t k = first; k < end; ++k) bits[k >> 6] &= ~(std::uint64_t{1} << (k & 63));
+    }
+    for (std::size_t i = 0; i < markedClusters_.size(); ++i) {
+        if (clusterMarks_[i] == QueryResult::Occluded) continue;
+        const MarkedCluster& m = markedClusters_[i];
+        history_.clusterBits(m.object, objs)[m.cluster >> 6] |= std::uint64_t{1} << (m.cluster & 63);
+    }
+    clusterRecordNs_ = 1e6 * msSince(t0);
+    f.stats.clusterMs += msSince(t0);
     lastClusterRecordFrame_ = f.index;
 }
 

@@ -54,6 +54,9 @@ struct QueryScheduler::Frame {
     /// draws only the clusters that showed last frame (their bits were recorded then), and
     /// this frame records which of its drawn parts' clusters show at its end.
     bool useClusterBits = false, recordClusterBits = false;
+    /// Recording cluster bits from the sink's range marks (SchedulerFeatures::useClusterMarks):
+    /// every part drawn as clusters is drawn one range per cluster, each marked.
+    bool markClusters = false;
 
     const Camera& camera() const { return view.camera; }
     const Frustum& frustum() const { return view.frustum; }

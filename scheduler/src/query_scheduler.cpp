@@ -237,6 +237,7 @@ void QueryScheduler::drawNode(Frame& f, NodeRef ref, bool untested, ClusterPass 
     } else {
         draw();
         if (f.marking) markedDraws_.push_back(ref);  // the sink marks its draws in this order
+        if (f.markClusters && clustered) noteMarkedRanges(ref);
     }
     f.stats.drawMs += msSince(t0);
     ++f.stats.partsDrawn;

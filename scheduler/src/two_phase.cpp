@@ -56,6 +56,10 @@ void QueryScheduler::runTwoPhase(Frame& f) {
     f.useClusterBits = clusterHistory && lastClusterRecordFrame_ + 1 == f.index;
     f.recordClusterBits = clusterHistory && (!params_.features.useCostModel || clusterBitsSavedNs_ > clusterRecordNs_ ||
                                              f.index - lastClusterRecordFrame_ >= params_.tuning.costs.probeFrames);
+    // Recorded from the draws' own fragments where the sink can mark each cluster drawn.
+    f.markClusters = f.recordClusterBits && params_.features.useClusterMarks && f.sink.marksRanges();
+    markedClusters_.clear();
+    if (f.markClusters) f.sink.beginRangeMarks();
 
     // 1. Early pass.
     const bool drewEarly = drawEarlySet(f);
@@ -94,7 +98,11 @@ void QueryScheduler::runTwoPhase(Frame& f) {
     if (!triangleTests_.empty()) testTriangles(f);
     if (triangles) readDrawMarks(f);
     if (!refresh_.empty()) testRefresh(f);
-    if (f.recordClusterBits && !clusterParts_.empty()) recordClusterVisibility(f);
+    if (f.markClusters) {
+        readClusterMarks(f);  // also ends the sink's marking
+    } else if (f.recordClusterBits && !clusterParts_.empty()) {
+        recordClusterVisibility(f);
+    }
     // A frame with no early depth (the first, or after everything turned hidden) had
     // nothing to test the pyramid against, so only the final-depth tests measured what
     // testing saves; without them the frame says nothing and the estimate stands.

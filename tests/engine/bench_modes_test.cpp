@@ -35,6 +35,9 @@ TEST(BenchModes, AblationsOfFullAndTheirVolumes) {
     EXPECT_TRUE(modeFromName("full")->scheduler.features.useClusterHistory);
     EXPECT_FALSE(modeFromName("full-noclusterhist")->scheduler.features.useClusterHistory);
     EXPECT_TRUE(modeFromName("full-noclusterhist")->scheduler.features.useClusters);
+    EXPECT_FALSE(modeFromName("full")->scheduler.features.useClusterMarks);
+    EXPECT_TRUE(modeFromName("full-markclusterhist")->scheduler.features.useClusterMarks);
+    EXPECT_TRUE(modeFromName("full-markclusterhist")->scheduler.features.useClusterHistory);
     EXPECT_TRUE(modeFromName("vfc")->scheduler.features.useClusters);
     EXPECT_FALSE(modeFromName("vfc-noclusters")->scheduler.features.useClusters);
     EXPECT_EQ(modeFromName("vfc-noclusters")->scheduler.mode, CullMode::Vfc);

@@ -3,7 +3,8 @@
 // frustum's edge, some behind a wall — seen from a camera circling them, in vfc (cones and
 // frustum) and full (the depth pyramid too), each frame compared pixel for pixel with the
 // same mode drawing whole parts. And the clusters do cull: triangles are saved. Cluster
-// history (useClusterHistory) keeps the same image while early parts draw fewer clusters.
+// history (useClusterHistory) keeps the same image while early parts draw fewer clusters,
+// with its bits from boxes or from the draws' marks.
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -131,37 +132,44 @@ TEST_F(ClusterHistory, EarlyPartsDrawOnlyWhatShowedAndTheImageStaysExact) {
     // Two-phase with cluster history draws an early part's clusters hidden last frame only
     // when the late pass finds them visible. Large spheres half behind a wall, the camera
     // circling: clusters go into and out of hiding while their parts stay visible. Every
-    // frame's image equals the one drawn with early parts whole, and vfc's.
+    // frame's image equals the one drawn with early parts whole, and vfc's; whether a
+    // cluster showed is judged by its box against the final depth (the default) or by its
+    // fragments' marks when drawn (useClusterMarks).
     build({2000, 8, 3.2f, 1.0f, {2.2f, 1.6f, 2.2f}});
     if (HasFatalFailure()) return;
-    SchedulerParams withHistory = paramsOf(CullMode::TwoPhase, true), without = withHistory;
-    without.features.useClusterHistory = false;
-    QueryScheduler history(withHistory), whole(without), vfc(paramsOf(CullMode::Vfc, true));
-    std::uint64_t deferred = 0, deferredDrawn = 0, drawnHistory = 0, drawnWhole = 0;
-    for (int f = 0; f < 24; ++f) {
-        circle(0.12f * float(f), 8.0f, 1.0f);
-        Image images[3];
-        const FrameStats h = render(history, images[0]);
-        const FrameStats w = render(whole, images[1]);
-        render(vfc, images[2]);
-        deferred += h.clustersDeferred;
-        deferredDrawn += h.deferredClustersDrawn;
-        drawnHistory += h.trianglesDrawn;
-        drawnWhole += w.trianglesDrawn;
-        EXPECT_LE(h.deferredClustersDrawn, h.clustersDeferred);
-        EXPECT_EQ(w.clustersDeferred, 0u);
-        EXPECT_EQ(differingPixels(images[0], images[1]), 0u) << "frame " << f;
-        EXPECT_EQ(differingPixels(images[0], images[2]), 0u) << "frame " << f;
+    for (const bool marks : {false, true}) {
+        SCOPED_TRACE(marks ? "bits from marks" : "bits from boxes");
+        SchedulerParams withHistory = paramsOf(CullMode::TwoPhase, true), without = withHistory;
+        withHistory.features.useClusterMarks = marks;
+        without.features.useClusterHistory = false;
+        QueryScheduler history(withHistory), whole(without), vfc(paramsOf(CullMode::Vfc, true));
+        std::uint64_t deferred = 0, deferredDrawn = 0, drawnHistory = 0, drawnWhole = 0;
+        for (int f = 0; f < 24; ++f) {
+            circle(0.12f * float(f), 8.0f, 1.0f);
+            Image images[3];
+            const FrameStats h = render(history, images[0]);
+            const FrameStats w = render(whole, images[1]);
+            render(vfc, images[2]);
+            deferred += h.clustersDeferred;
+            deferredDrawn += h.deferredClustersDrawn;
+            drawnHistory += h.trianglesDrawn;
+            drawnWhole += w.trianglesDrawn;
+            EXPECT_LE(h.deferredClustersDrawn, h.clustersDeferred);
+            EXPECT_EQ(w.clustersDeferred, 0u);
+            EXPECT_EQ(differingPixels(images[0], images[1]), 0u) << "frame " << f;
+            EXPECT_EQ(differingPixels(images[0], images[2]), 0u) << "frame " << f;
+        }
+        std::printf("cluster history (%s): %llu clusters deferred, %llu of them drawn late; %llu triangles drawn against %llu\n",
+                    marks ? "marks" : "boxes", static_cast<unsigned long long>(deferred),
+                    static_cast<unsigned long long>(deferredDrawn), static_cast<unsigned long long>(drawnHistory),
+                    static_cast<unsigned long long>(drawnWhole));
+        EXPECT_EQ(ctx_->checkErrors(), 0u);
+        // Clusters hid behind the wall and were held back from early passes; some came out
+        // again (the camera moves) and the late pass drew them; in all, fewer triangles drawn.
+        EXPECT_GT(deferred, 0u);
+        EXPECT_GT(deferredDrawn, 0u);
+        EXPECT_LT(drawnHistory, drawnWhole);
     }
-    std::printf("cluster history: %llu clusters deferred, %llu of them drawn late; %llu triangles drawn against %llu\n",
-                static_cast<unsigned long long>(deferred), static_cast<unsigned long long>(deferredDrawn),
-                static_cast<unsigned long long>(drawnHistory), static_cast<unsigned long long>(drawnWhole));
-    EXPECT_EQ(ctx_->checkErrors(), 0u);
-    // Clusters hid behind the wall and were held back from early passes; some came out
-    // again (the camera moves) and the late pass drew them; in all, fewer triangles drawn.
-    EXPECT_GT(deferred, 0u);
-    EXPECT_GT(deferredDrawn, 0u);
-    EXPECT_LT(drawnHistory, drawnWhole);
 }
 
 TEST_F(ClusterCulling, PixelSizedClustersKeepTheImageExact) {

@@ -84,9 +84,13 @@ public:
     void drawRange(MeshId id, std::uint32_t firstIndex, std::uint32_t indexCount, const glm::mat4& model,
                    const glm::vec3& colour, std::uint32_t markSlot = kNoMark);
     /// drawRange of several ranges of mesh `id` at once (one glMultiDrawElements): a part
-    /// drawn as its surviving clusters. Counted as one draw call.
+    /// drawn as its surviving clusters. Counted as one draw call. With `markEachRange`
+    /// (needs supportsRangeMarks() and a `markSlot`), range i marks slot markSlot + i, so
+    /// each cluster drawn says whether it showed a sample; otherwise the draw marks one slot.
     void drawRanges(MeshId id, std::span<const IndexRange> ranges, const glm::mat4& model, const glm::vec3& colour,
-                    std::uint32_t markSlot = kNoMark);
+                    std::uint32_t markSlot = kNoMark, bool markEachRange = false);
+    /// Whether drawRanges can mark each range (the GL has ARB_shader_draw_parameters, or is 4.6).
+    bool supportsRangeMarks() const { return rangeMarks_; }
     /// The exact occlusion test of a range's own triangles: drawRange's fragments (the same
     /// positions, by an invariant expression, and the same face culling), depth-tested
     /// with the current depth function, mark `markSlot` as drawRange's marks do. Only the
@@ -144,7 +148,8 @@ private:
     GlContext& context_;
     std::vector<GpuMesh> meshes_;
     std::size_t uploadedBytes_ = 0;
-    LitProgram programs_[2][2];  // by Shading, then plain (0) or marking (1)
+    LitProgram programs_[2][3];  // by Shading, then by detail::MarkKind (plain, per draw, per range; 0 if not built)
+    bool rangeMarks_ = false;    // the per-range variants were built
     struct TestProgram {
         std::uint32_t id = 0;
         int viewProj = -1, model = -1, markSlot = -1;
@@ -158,7 +163,7 @@ private:
     std::vector<int> multiCounts_;            // drawRanges' arguments, reused
     std::vector<const void*> multiOffsets_;
     /// Binds mesh `g`'s program, uniforms, face culling and vertex array for a draw.
-    void bindDraw(const GpuMesh& g, const glm::mat4& model, const glm::vec3& colour, std::uint32_t markSlot);
+    void bindDraw(const GpuMesh& g, const glm::mat4& model, const glm::vec3& colour, std::uint32_t markSlot, bool markEachRange);
     RenderStats stats_;
 };
 

@@ -184,6 +184,16 @@ public:
     /// a cluster facing away from the eye shows nothing (false: the default).
     virtual bool cullsBackFaces() const { return false; }
 
+    /// Whether the two calls below work, where drawsRanges() does (false: the default).
+    virtual bool marksRanges() const { return false; }
+    /// From now until readRangeMarks, every range drawn by drawPartRanges and
+    /// drawMorePartRanges also records whether any of its fragments passed the depth test as
+    /// it was drawn (drawPart's draws record nothing): which clusters of a part showed.
+    virtual void beginRangeMarks() {}
+    /// Those records, one per range drawn since beginRangeMarks, in call and range order:
+    /// Visible if a fragment passed, else Occluded; ends the marking. Waits for the drawing.
+    virtual void readRangeMarks(std::span<QueryResult> out) { std::fill(out.begin(), out.end(), QueryResult::Visible); }
+
     /// Whether the three calls below work (false: the default, e.g. a game's own draws).
     virtual bool testsTriangles() const { return false; }
     /// From now to the end of the frame, every drawPart also records whether any fragment

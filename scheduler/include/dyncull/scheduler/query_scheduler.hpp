@@ -98,6 +98,16 @@ struct SchedulerFeatures {
     /// conservative. Costs a second depth readback per frame that tests. Off: parts drawn
     /// early whole (an ablation).
     bool useClusterHistory = true;
+    /// Cluster history, where the PartSink marks ranges (PartSink::marksRanges: the engine's
+    /// part renderer on a GL with ARB_shader_draw_parameters): a cluster's bit says whether
+    /// any of its fragments passed the depth test when it was drawn, instead of whether its
+    /// box showed in the final depth. Exact per pixel at draw time, and no second depth
+    /// readback; but off by default, since it loses: a cluster whose box peeks past its
+    /// occluders while its triangles do not is deferred, the late pass's box test cannot
+    /// reject it either, so it is drawn late anyway, after an early pass whose depth now
+    /// lacks it (on issue 21's swarm half the early triangles, 1.3x the triangles in all;
+    /// docs/BENCHMARKS.md). An ablation, bench mode full-markclusterhist.
+    bool useClusterMarks = false;
     /// TwoPhase (and clusters): test only where SchedulerTuning::costs expects the test to
     /// pay. Off: every volume the pyramid lets through is tested (an ablation).
     bool useCostModel = true;
@@ -460,8 +470,9 @@ private:
     std::vector<IndexRange> clusterRanges_;
     std::vector<double> clusterCulledRate_;
     /// Tests the clusters of part `ref` (node `n` of `model`) where they may pay, leaving
-    /// the survivors in clusterRanges_ (adjacent ones merged); false if the part is to be
-    /// drawn whole.
+    /// the survivors in clusterRanges_ (adjacent ones merged, unless the frame marks
+    /// clusters: then one range per cluster, its index in clusterRangeIds_); false if the
+    /// part is to be drawn whole.
     bool cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, const LocalBspNode& n, ClusterPass pass);
     // useClusterHistory: the parts drawn early that deferred clusters, and every part whose
     // clusters were drawn or tested this frame (their bits are written at the frame's end).
@@ -485,6 +496,20 @@ private:
     /// At the frame's end: the final depth read back into the pyramid and every cluster of
     /// clusterParts_ tested against it, into the parts' cluster bits.
     void recordClusterVisibility(Frame& f);
+    // useClusterMarks: the cluster each range of clusterRanges_ is (its index in its
+    // model's clusters), and every cluster drawn this frame in the order its mark comes back.
+    struct MarkedCluster {
+        std::uint32_t object;   ///< index in SceneObjects (no object is removed mid-frame)
+        std::uint32_t cluster;  ///< index in its model's LocalBsp::clusters
+    };
+    std::vector<std::uint32_t> clusterRangeIds_;
+    std::vector<MarkedCluster> markedClusters_;
+    std::vector<QueryResult> clusterMarks_;
+    /// After a draw of clusterRanges_ for part `ref` while marking clusters: their marks' order.
+    void noteMarkedRanges(NodeRef ref);
+    /// At the frame's end: the marks of every cluster drawn, into the bits of clusterParts_
+    /// (a cluster of theirs not drawn, or drawn and hidden, is cleared).
+    void readClusterMarks(Frame& f);
 };
 
 }  // namespace dyncull
