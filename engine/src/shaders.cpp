@@ -105,12 +105,7 @@ uniform uint uMarkSlot;
 )";
 const char* const kMarkStatement = "marks[uMarkSlot] = 1u";
 namespace {
-const char* const kRangeMarksDeclaration = R"(
-layout(early_fragment_tests) in;
-layout(std430, binding = 1) writeonly buffer Marks { uint marks[]; };
-uniform uint uMarkSlot;
-flat in uint vRange;
-)";
+const char* const kRangeInput = "flat in uint vRange;\n";  // after kMarksDeclaration
 const char* const kRangeMarkStatement = "marks[uMarkSlot + vRange] = 1u";
 const char* const kRangeVertexDeclaration = R"(#extension GL_ARB_shader_draw_parameters : require
 flat out uint vRange;
@@ -126,7 +121,8 @@ void fill(std::string& s, std::string_view placeholder, std::string_view text) {
 std::string litFragmentSource(const char* source, MarkKind marks) {
     std::string s(source);
     // The declaration first: DYNCULL_MARK is its prefix.
-    fill(s, "DYNCULL_MARKS_DECLARATION", marks == MarkKind::Draw ? kMarksDeclaration : marks == MarkKind::Range ? kRangeMarksDeclaration : "");
+    const std::string declaration = marks == MarkKind::None ? "" : std::string(kMarksDeclaration) + (marks == MarkKind::Range ? kRangeInput : "");
+    fill(s, "DYNCULL_MARKS_DECLARATION", declaration);
     fill(s, "DYNCULL_MARK", marks == MarkKind::Draw ? kMarkStatement : marks == MarkKind::Range ? kRangeMarkStatement : "");
     return s;
 }

@@ -29,8 +29,6 @@ bool clusterHidden(const QueryScheduler::Frame& f, const DepthPyramid* pyramid, 
     // A pyramid exists only for a single-sample target: a cluster covering no pixel centre draws nothing.
     return fp.centres.empty() || pyramid->occluded(fp.centres, fp.nearest);
 }
-
-bool bitSet(std::span<const std::uint64_t> bits, std::uint32_t i) { return (bits[i >> 6] >> (i & 63)) & 1u; }
 }  // namespace
 
 bool QueryScheduler::cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, const LocalBspNode& n, ClusterPass pass) {
@@ -82,7 +80,7 @@ bool QueryScheduler::cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, 
         const LeafCluster& c = clusters[i];
         // Deferred: drawn early already. Early: hidden last frame, left to the late pass
         // if it faces the eye and is in the frustum.
-        const bool otherPass = split && bitSet(shown, firstCluster + i) == (pass == ClusterPass::Deferred);
+        const bool otherPass = split && clusterBit(shown, firstCluster + i) == (pass == ClusterPass::Deferred);
         const bool drawnEarly = pass == ClusterPass::Deferred && otherPass;
         bool culled = !drawnEarly && cones && eye.backFacing(c);
         if (!drawnEarly && !culled && (frustum || pyramid)) culled = clusterHidden(f, pyramid ? &pyramid_ : nullptr, matrix, c, frustum);

@@ -67,7 +67,6 @@ void QueryScheduler::recordClusterVisibility(Frame& f) {
         const ObjectSpaceEye eye(f.camera(), matrix);
         for (std::uint32_t i = 0; i < clusters.size(); ++i) {
             const std::uint32_t k = first + i;
-            const std::uint64_t bit = std::uint64_t{1} << (k & 63);
             const LeafCluster& c = clusters[i];
             // No guarantee needed here (a deferred cluster is tested in the late pass), so
             // the box is projected roughly: in float, without rounding margins.
@@ -76,11 +75,7 @@ void QueryScheduler::recordClusterVisibility(Frame& f) {
             const bool hidden = (cones && eye.backFacing(c)) ||
                                 (f.screen.roughBoxDepth(toClip, c.box, centres, nearest) &&
                                  (centres.empty() || pyramid_.occluded(centres, nearest, kRecordSpan)));
-            if (hidden) {
-                bits[k >> 6] &= ~bit;
-            } else {
-                bits[k >> 6] |= bit;
-            }
+            setClusterBit(bits, k, !hidden);
         }
     }
     f.stats.clusterMs += msSince(t1);
@@ -105,12 +100,19 @@ void QueryScheduler::readClusterMarks(Frame& f) {
         const std::span<std::uint64_t> bits = history_.clusterBits(ref.object, objs);
         const std::uint32_t first = model.clusters.nodeFirst[ref.node];
         const std::uint32_t end = first + static_cast<std::uint32_t>(model.clusters.ofSubtree(ref.node, model.nodes[ref.node].subtreeSize).size());
-        for (std::uint32_t k = first; k < end; ++k) bits[k >> 6] &= ~(std::uint64_t{1} << (k & 63));
+        for (std::uint32_t k = first; k < end; ++k) setClusterBit(bits, k, false);
     }
+    // Marks come back part by part: the object's bits are looked up once per run.
+    std::uint32_t object = kInvalidIndex;
+    std::span<std::uint64_t> bits;
     for (std::size_t i = 0; i < markedClusters_.size(); ++i) {
         if (clusterMarks_[i] == QueryResult::Occluded) continue;
         const MarkedCluster& m = markedClusters_[i];
-        history_.clusterBits(m.object, objs)[m.cluster >> 6] |= std::uint64_t{1} << (m.cluster & 63);
+        if (m.object != object) {
+            object = m.object;
+            bits = history_.clusterBits(object, objs);
+        }
+        setClusterBit(bits, m.cluster, true);
     }
     clusterRecordNs_ = 1e6 * msSince(t0);
     f.stats.clusterMs += msSince(t0);

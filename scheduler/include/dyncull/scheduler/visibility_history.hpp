@@ -46,9 +46,10 @@ public:
     /// One bit per cluster of the object's model (LocalBsp::clusters, in order; bit i of
     /// the span is word i / 64, bit i % 64), kept, created and reset with the object's
     /// node records: the cluster-level history of TwoPhase (SchedulerFeatures::
-    /// useClusterHistory), where a set bit means the cluster's box showed in the final
-    /// depth of the last frame its part was drawn in. Empty for a model without clusters.
-    /// Valid until the next call that creates records.
+    /// useClusterHistory), where a set bit means the cluster showed in the last frame its
+    /// part was drawn in: its box in the final depth, or with useClusterMarks a fragment of
+    /// it when drawn. Empty for a model without clusters. Valid until the next call that
+    /// creates records. Read and written through clusterBit / setClusterBit.
     std::span<std::uint64_t> clusterBits(std::uint32_t object, const SceneObjects& objects);
     void clear();
 
@@ -77,5 +78,13 @@ private:
     std::vector<std::uint32_t> objectGen_;   // per slot: generation the block belongs to
     std::vector<std::uint32_t> objectModel_;
 };
+
+/// Bit `i` of a VisibilityHistory::clusterBits span.
+inline bool clusterBit(std::span<const std::uint64_t> bits, std::uint32_t i) { return (bits[i >> 6] >> (i & 63)) & 1u; }
+/// Sets bit `i` of a VisibilityHistory::clusterBits span to `value`.
+inline void setClusterBit(std::span<std::uint64_t> bits, std::uint32_t i, bool value) {
+    const std::uint64_t bit = std::uint64_t{1} << (i & 63);
+    bits[i >> 6] = value ? bits[i >> 6] | bit : bits[i >> 6] & ~bit;
+}
 
 }  // namespace dyncull
