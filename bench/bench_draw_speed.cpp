@@ -34,6 +34,7 @@
 #include "dyncull/demos/demo_scene.hpp"
 #include "dyncull/engine/engine.hpp"
 #include "dyncull/engine/gl_context.hpp"
+#include "dyncull/engine/heap_tuning.hpp"
 #include "dyncull/engine/image.hpp"
 #include "dyncull/measure/image_compare.hpp"
 #include "dyncull/objects/checked_write.hpp"
@@ -299,6 +300,7 @@ Swarm makeSwarm(GlContext& ctx, BunnySwarmOptions options) {
 
 int main(int argc, char** argv) {
     using namespace dyncull;
+    keepFreedHeapMemory();  // as the dyncull program does: every variant draws through the same heap
     CLI::App app{"Draw speed of dyncull's renderer against a speed-of-light reference (bunny swarm)"};
     BunnySwarmOptions o;
     o.count = 300;

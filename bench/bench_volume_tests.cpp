@@ -17,6 +17,7 @@
 
 #include "dyncull/engine/gl_context.hpp"
 #include "dyncull/engine/gl_query_backend.hpp"
+#include "dyncull/engine/heap_tuning.hpp"
 #include "dyncull/engine/renderer.hpp"
 
 namespace {
@@ -65,6 +66,7 @@ struct Case {
 }  // namespace
 
 int main(int argc, char** argv) {
+    dyncull::keepFreedHeapMemory();  // as the dyncull program does
     CLI::App app{"Cost of the batched raster test and of hardware queries per volume (640x360)"};
     int rounds = 9;
     app.add_option("--rounds", rounds, "timed rounds per case (median reported)")->check(CLI::Range(1, 1000))->capture_default_str();

@@ -5,11 +5,14 @@
 
 #include <CLI/CLI.hpp>
 
+#include "dyncull/engine/heap_tuning.hpp"
+
 #include "cli_util.hpp"
 #include "commands.hpp"
 #include "crash_report.hpp"
 
 int main(int argc, char** argv) {
+    dyncull::keepFreedHeapMemory();  // llvmpipe's per-draw blocks, not trimmed and faulted in again each frame
     dyncull::cli::installCrashReporter("dyncull");
     dyncull::cli::setCommandLine(argc, argv);
     CLI::App app{"dyncull: occlusion culling for dynamic scenes (two-level BSP + occlusion queries)"};

@@ -28,6 +28,7 @@
 
 #include <dyncull/bsp/local_bsp.hpp>
 #include <dyncull/engine/engine.hpp>
+#include <dyncull/engine/heap_tuning.hpp>
 
 namespace {
 
@@ -167,6 +168,8 @@ GpuModel upload(const dyncull::LocalBsp& bsp, const std::vector<float>& colours)
 }  // namespace
 
 int main(int argc, char** argv) {
+    // The game's choice, not the library's: on llvmpipe, keep the heap that each draw reuses.
+    dyncull::keepFreedHeapMemory();
     int frames = 30;
     std::string screenshot = "headless_game.png", cull = "full";
     bool check = false;
