@@ -16,16 +16,16 @@
 namespace dyncull {
 
 namespace {
-/// True if cluster `c` of an object with `matrix` shows nothing: outside the frustum (if
-/// `frustum`: its part crosses it), or behind the depth pyramid (if `pyramid`). A cluster
-/// the eye is inside of or that reaches the near plane is visible; one off screen is not.
-bool clusterHidden(const QueryScheduler::Frame& f, const DepthPyramid* pyramid, const glm::mat4& matrix, const LeafCluster& c,
-                   bool frustum) {
-    const Aabb world = transformAabb(matrix, c.box);
-    if (frustum && f.frustum().outside(world)) return true;
-    if (!pyramid || world.contains(f.camera().position)) return false;
+/// True if cluster `c` of an object with `matrix` (prepared as `object`) shows nothing:
+/// outside the frustum (if `frustum`: its part crosses it), or behind the depth pyramid (if
+/// `pyramid`). A cluster the eye is inside of or that reaches the near plane is visible
+/// (boxDepth says so); one off screen is not.
+bool clusterHidden(const QueryScheduler::Frame& f, const DepthPyramid* pyramid, const glm::mat4& matrix, const ObjectProjection& object,
+                   const LeafCluster& c, bool frustum) {
+    if (frustum && f.frustum().outside(transformAabb(matrix, c.box))) return true;
+    if (!pyramid) return false;
     DepthFootprint fp;
-    if (!f.screen.volumeDepth(QueryVolume::fromTransformedBox(matrix, c.box), fp)) return false;
+    if (!f.screen.boxDepth(object, matrix, c.box, fp)) return false;
     // A pyramid exists only for a single-sample target: a cluster covering no pixel centre draws nothing.
     return fp.centres.empty() || pyramid->occluded(fp.centres, fp.nearest);
 }
@@ -69,6 +69,7 @@ bool QueryScheduler::cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, 
 
     const auto t0 = SchedulerClock::now();
     const glm::mat4& matrix = objs.matrix(ref.object);
+    const ObjectProjection object = pyramid ? f.screen.objectProjection(matrix) : ObjectProjection{};
     const std::span<const std::uint64_t> shown = split ? history_.clusterBits(ref.object, objs) : std::span<const std::uint64_t>{};
     const std::uint32_t firstCluster = model.clusters.nodeFirst[ref.node];
     const ObjectSpaceEye eye(f.camera(), matrix);
@@ -83,7 +84,7 @@ bool QueryScheduler::cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, 
         const bool otherPass = split && clusterBit(shown, firstCluster + i) == (pass == ClusterPass::Deferred);
         const bool drawnEarly = pass == ClusterPass::Deferred && otherPass;
         bool culled = !drawnEarly && cones && eye.backFacing(c);
-        if (!drawnEarly && !culled && (frustum || pyramid)) culled = clusterHidden(f, pyramid ? &pyramid_ : nullptr, matrix, c, frustum);
+        if (!drawnEarly && !culled && (frustum || pyramid)) culled = clusterHidden(f, pyramid ? &pyramid_ : nullptr, matrix, object, c, frustum);
         if (culled) {
             ++culledClusters;
             culledTriangles += c.indexCount / 3;

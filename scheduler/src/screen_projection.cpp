@@ -115,6 +115,43 @@ bool ScreenProjection::volumeDepth(const QueryVolume& volume, DepthFootprint& ou
     std::array<glm::dvec3, QueryVolume::kMaxVertices> rel;
     bool asBox = false;
     const std::uint32_t n = volume.enlargedForRounding(glm::dvec3(view_.camera.position), rel, asBox);
+    return pointsDepth(rel.data(), n, out);
+}
+
+ObjectProjection ScreenProjection::objectProjection(const glm::mat4& matrix) const {
+    ObjectProjection p;
+    p.toWorld = glm::dmat4(matrix);
+    const glm::dvec3 c0(p.toWorld[0]), c1(p.toWorld[1]), c2(p.toWorld[2]);
+    const double det = std::abs(glm::dot(c0, glm::cross(c1, c2)));
+    const double a0 = glm::length(glm::cross(c1, c2)), a1 = glm::length(glm::cross(c2, c0)), a2 = glm::length(glm::cross(c0, c1));
+    p.faceScale = {a0 > 0.0 ? det / a0 : 0.0, a1 > 0.0 ? det / a1 : 0.0, a2 > 0.0 ? det / a2 : 0.0};
+    return p;
+}
+
+bool ScreenProjection::boxDepth(const ObjectProjection& object, const glm::mat4& matrix, const Aabb& local, DepthFootprint& out) const {
+    // QueryVolume::enlargedForRounding for a box: its vertices' magnitude sets the margin,
+    // and each face is pushed out by it through a scale about the centre by k.
+    const glm::dvec3 lo(local.min), hi(local.max);
+    const glm::dvec4 centre(0.5 * (lo + hi), 1.0);
+    const glm::dvec3 half = 0.5 * (hi - lo);
+    const glm::dvec3 worldCentre(object.toWorld * centre);
+    const glm::dvec3 axis[3] = {glm::dvec3(object.toWorld[0]) * half.x, glm::dvec3(object.toWorld[1]) * half.y,
+                                glm::dvec3(object.toWorld[2]) * half.z};
+    const glm::dvec3 reach = glm::abs(worldCentre) + glm::abs(axis[0]) + glm::abs(axis[1]) + glm::abs(axis[2]);
+    const double magnitude = std::max({reach.x, reach.y, reach.z});  // of the farthest corner, per coordinate
+    const double push = magnitude * 0x1p-22 * std::sqrt(3.0);
+    const double nearest = std::min({half.x * object.faceScale.x, half.y * object.faceScale.y, half.z * object.faceScale.z});
+    if (!(nearest > 4.0 * push)) return volumeDepth(QueryVolume::fromTransformedBox(matrix, local), out);  // thin: as a box of boxes
+    const double k = 1.0 + push / nearest;
+    const glm::dvec3 relCentre = worldCentre - glm::dvec3(view_.camera.position);
+    std::array<glm::dvec3, 8> rel;
+    for (int i = 0; i < 8; ++i)
+        rel[static_cast<std::size_t>(i)] =
+            relCentre + k * ((i & 1) ? axis[0] : -axis[0]) + k * ((i & 2) ? axis[1] : -axis[1]) + k * ((i & 4) ? axis[2] : -axis[2]);
+    return pointsDepth(rel.data(), 8, out);
+}
+
+bool ScreenProjection::pointsDepth(const glm::dvec3* rel, std::uint32_t n, DepthFootprint& out) const {
     double magnitude = 0.0;
     for (std::uint32_t i = 0; i < n; ++i)
         magnitude = std::max({magnitude, std::abs(rel[i].x), std::abs(rel[i].y), std::abs(rel[i].z)});

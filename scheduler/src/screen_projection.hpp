@@ -25,6 +25,16 @@ struct DepthFootprint {
     float nearest = 1.0f;  ///< nearest window depth (reversed Z: the largest of its points')
 };
 
+/// One object's matrix prepared for the footprints of many boxes in its object space (a
+/// part's clusters): ScreenProjection::boxDepth's per-object terms, computed once. Double.
+struct ObjectProjection {
+    glm::dmat4 toWorld{1.0};  ///< object space to world space
+    /// Per axis i: how far the transformed box's two faces across axis i lie from its centre,
+    /// per unit of the box's half extent along i (|det| / |column j x column k| of the
+    /// matrix's linear part); 0 for a singular matrix.
+    glm::dvec3 faceScale{0.0};
+};
+
 /// Projects world-space boxes and volumes into one frame's viewport (pixels, origin at the
 /// lower left, as the occupancy maps and the depth pyramid count them). Borrows the view.
 class ScreenProjection {
@@ -40,6 +50,15 @@ public:
     /// its vertices' rounding first; false if it reaches the near plane (then it is simply
     /// visible).
     bool volumeDepth(const QueryVolume& volume, DepthFootprint& out) const;
+    /// `matrix` (object to world) prepared for boxDepth.
+    ObjectProjection objectProjection(const glm::mat4& matrix) const;
+    /// volumeDepth(QueryVolume::fromTransformedBox(matrix, local), out) for the object that
+    /// `object` was prepared from, without building the volume: the box's centre and half
+    /// axes are transformed once in double and its corners combined from them, and the
+    /// faces' distances come from ObjectProjection::faceScale instead of the 12 triangles.
+    /// The same margins for rounding, from the exact corners instead of their float
+    /// roundings; a box too thin for them goes through volumeDepth.
+    bool boxDepth(const ObjectProjection& object, const glm::mat4& matrix, const Aabb& local, DepthFootprint& out) const;
     /// A guess, for choices that need no guarantee (cluster history's record of what
     /// showed): the pixels whose centres box `local` under `objectToClip` (object space to
     /// clip space, camera-relative: clipMatrixOf) covers and its nearest window depth, its 8
@@ -60,6 +79,9 @@ private:
     double viewDistance(const glm::dvec4& clip, const glm::dvec3& rel) const {
         return view_.camera.orthographic() ? glm::dot(distanceRow_, glm::dvec4(rel, 1.0)) : clip.w;
     }
+
+    /// The footprint of the eye-relative points `rel[0, n)`, which already hold their margins.
+    bool pointsDepth(const glm::dvec3* rel, std::uint32_t n, DepthFootprint& out) const;
 
     const FrameView& view_;
     glm::dvec4 distanceRow_;  // Camera::distanceRowRelative

@@ -1,0 +1,128 @@
+// ScreenProjection::boxDepth, the clusters' fast footprint, against its reference: the
+// general volume path on the box built as a query volume (volumeDepth of
+// QueryVolume::fromTransformedBox), on random boxes, matrices and cameras, perspective and
+// orthographic, with degenerate (flat) boxes and huge coordinates on purpose.
+#include <cmath>
+#include <random>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <gtest/gtest.h>
+
+#include "screen_projection.hpp"
+
+namespace dyncull {
+namespace {
+
+// Both paths round differently (float vertices against exact double ones), so their
+// rectangles may differ by the one pixel a rounding can move an edge across.
+void expectRectNear(const ScreenRect& a, const ScreenRect& b) {
+    EXPECT_LE(std::abs(a.x0 - b.x0), 1);
+    EXPECT_LE(std::abs(a.y0 - b.y0), 1);
+    EXPECT_LE(std::abs(a.x1 - b.x1), 1);
+    EXPECT_LE(std::abs(a.y1 - b.y1), 1);
+}
+
+struct Case {
+    Camera camera;
+    glm::mat4 matrix{1.0f};
+    Aabb box;
+};
+
+Case randomCase(std::mt19937& rng, bool orthographic, float scale) {
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f), pos(0.05f, 1.0f);
+    Case c;
+    c.camera.position = glm::vec3(u(rng), u(rng), 6.0f + u(rng)) * scale;
+    c.camera.target = glm::vec3(u(rng), u(rng), u(rng)) * scale;
+    c.camera.nearPlane = 0.05f * scale;
+    c.camera.farPlane = 100.0f * scale;
+    if (orthographic) c.camera.orthoHeight = 8.0f * scale;
+    glm::mat4 m = glm::translate(glm::mat4(1.0f), glm::vec3(u(rng), u(rng), u(rng)) * scale);
+    m = glm::rotate(m, 3.0f * u(rng), glm::normalize(glm::vec3(u(rng), u(rng), u(rng)) + glm::vec3(0.0f, 0.0f, 1.5f)));
+    m = glm::scale(m, glm::vec3(pos(rng), pos(rng), pos(rng)) * scale);
+    c.matrix = m;
+    const glm::vec3 lo(u(rng), u(rng), u(rng));
+    c.box = Aabb::fromMinMax(lo, lo + glm::vec3(pos(rng), pos(rng), pos(rng)));
+    return c;
+}
+
+void compare(const Case& c, int& projected) {
+    const FrameView view = FrameView::of(c.camera, 640, 360);
+    const ScreenProjection screen(view);
+    DepthFootprint fast, reference;
+    const bool fastInFront = screen.boxDepth(screen.objectProjection(c.matrix), c.matrix, c.box, fast);
+    const bool referenceInFront = screen.volumeDepth(QueryVolume::fromTransformedBox(c.matrix, c.box), reference);
+    ASSERT_EQ(fastInFront, referenceInFront);
+    if (!fastInFront) return;
+    ++projected;
+    expectRectNear(fast.rect, reference.rect);
+    expectRectNear(fast.centres, reference.centres);
+    EXPECT_NEAR(fast.nearest, reference.nearest, 1e-5f * std::max(1.0f, std::abs(reference.nearest)));
+    // Conservative on its own: every exact corner projects inside it, no nearer than it says.
+    for (int i = 0; i < 8; ++i) {
+        const glm::dvec3 local((i & 1) ? c.box.max.x : c.box.min.x, (i & 2) ? c.box.max.y : c.box.min.y, (i & 4) ? c.box.max.z : c.box.min.z);
+        const glm::dvec3 rel = glm::dvec3(glm::dmat4(c.matrix) * glm::dvec4(local, 1.0)) - glm::dvec3(c.camera.position);
+        const glm::dvec4 clip = view.viewProjRelative * glm::dvec4(rel, 1.0);
+        const glm::dvec2 px = (glm::dvec2(clip) / clip.w + 1.0) * 0.5 * glm::dvec2(view.width, view.height);
+        EXPECT_LE(clip.z / clip.w, double(fast.nearest) + 1e-7);
+        if (px.x >= 0.0 && px.x <= view.width && px.y >= 0.0 && px.y <= view.height) {
+            EXPECT_GE(px.x, fast.rect.x0);
+            EXPECT_LE(px.x, fast.rect.x1);
+            EXPECT_GE(px.y, fast.rect.y0);
+            EXPECT_LE(px.y, fast.rect.y1);
+        }
+    }
+}
+
+TEST(ScreenProjection, BoxDepthMatchesTheVolumePath) {
+    std::mt19937 rng(7);
+    for (const bool orthographic : {false, true})
+        for (const float scale : {1.0f, 1e-3f, 1e4f}) {
+            int projected = 0;
+            for (int i = 0; i < 400; ++i) compare(randomCase(rng, orthographic, scale), projected);
+            EXPECT_GT(projected, 100) << "too few boxes in front of the eye to compare";
+        }
+}
+
+TEST(ScreenProjection, BoxDepthOfDegenerateBoxes) {
+    std::mt19937 rng(11);
+    int projected = 0;
+    for (int i = 0; i < 300; ++i) {
+        Case c = randomCase(rng, false, 1.0f);
+        // Flat along one axis, along two (a segment), or a point: the thin path, as the reference takes it.
+        const int flat = i % 3;
+        c.box.max.x = c.box.min.x;
+        if (flat >= 1) c.box.max.y = c.box.min.y;
+        if (flat >= 2) c.box.max.z = c.box.min.z;
+        compare(c, projected);
+    }
+    EXPECT_GT(projected, 100);
+}
+
+TEST(ScreenProjection, BoxDepthFarFromTheOrigin) {
+    // Huge coordinates: the rounding margins grow with them, and both paths must agree.
+    std::mt19937 rng(13);
+    int projected = 0;
+    for (int i = 0; i < 300; ++i) {
+        Case c = randomCase(rng, false, 1.0f);
+        const glm::vec3 far(3e6f, -2e6f, 1e6f);
+        c.camera.position += far;
+        c.camera.target += far;
+        c.matrix = glm::translate(glm::mat4(1.0f), far) * c.matrix;
+        compare(c, projected);
+    }
+    EXPECT_GT(projected, 100);
+}
+
+TEST(ScreenProjection, BoxAroundTheEyeIsVisible) {
+    Camera camera;
+    camera.position = {0.3f, -0.2f, 0.1f};
+    camera.target = {0.0f, 0.0f, -5.0f};
+    const FrameView view = FrameView::of(camera, 640, 360);
+    const ScreenProjection screen(view);
+    const glm::mat4 m = glm::rotate(glm::mat4(1.0f), 0.7f, glm::vec3(0.0f, 1.0f, 0.0f));
+    DepthFootprint fp;
+    EXPECT_FALSE(screen.boxDepth(screen.objectProjection(m), m, Aabb::fromMinMax({-1.0f, -1.0f, -1.0f}, {1.0f, 1.0f, 1.0f}), fp));
+}
+
+}  // namespace
+}  // namespace dyncull
