@@ -392,7 +392,13 @@ bool QueryScheduler::exploring(NodeRef ref) const {
 
 QueryVolume QueryScheduler::testedVolume(const Frame& f, NodeRef ref) const {
     if (ref.isSceneNode() || !params_.features.useTightVolumes) return QueryVolume::fromAabb(f.tree.worldBox(ref));
-    return objectNodeVolume(f.objects, ref, params_.tuning.volume, params_.tuning.autoVolumeSaving);
+    // A part drawn as clusters has its clusters' boxes tested against the pyramid once its
+    // volume passes, and they bound it tighter than any one volume: a k-DOP's extra
+    // triangles then cost every pyramid and raster test and save little, so Auto takes the
+    // better of its two boxes (a k-DOP would have to save all of the box's area).
+    const LocalBsp& model = f.objects.model(f.objects.modelOf(ref.object));
+    const bool asClusters = params_.features.useClusters && f.sink.drawsRanges() && model.clusters.builtFor(model.nodes.size());
+    return objectNodeVolume(f.objects, ref, params_.tuning.volume, asClusters ? 1.0f : params_.tuning.autoVolumeSaving);
 }
 
 void QueryScheduler::rasterTest(Frame& f, const std::vector<NodeRef>& parts, bool countSamples) {
