@@ -201,7 +201,7 @@ struct SchedulerTuning {
     /// noise on the city and Sponza (docs/BENCHMARKS.md). In TwoPhase a part drawn as
     /// clusters takes the better of its two boxes under Auto, whatever autoVolumeSaving:
     /// its clusters' own tests make a k-DOP's extra triangles cost more than they save
-    /// (0.86-0.91x the frame time on the swarm, the bunnies and the power plant).
+    /// (docs/BENCHMARKS.md, "boxes, not k-DOPs, for parts drawn as clusters").
     VolumeChoice volume = VolumeChoice::Auto;
     /// Auto: a k-DOP replaces the node's best box only if it has at least this fraction
     /// less surface area (in [0, 1]). Chosen by measurement: see docs/BENCHMARKS.md.
