@@ -75,7 +75,7 @@ bool applyTwoPhaseName(const std::string& part, ModeSpec& m) {
         return true;
     }
     if (part != "full" && part != "full-hzb" && part != "full-nohist" && part != "full-nocost" && part != "full-tri" &&
-        part != "full-noclusters" && part != "full-noclusterhist" && part != "full-markclusterhist")
+        part != "full-noclusters" && part != "full-noclusterhist" && part != "full-markclusterhist" && part != "full-noworker")
         return false;
     m.scheduler.mode = CullMode::TwoPhase;
     m.scheduler.features.useBatchedRaster = part != "full-hzb";
@@ -91,6 +91,7 @@ bool applyTwoPhaseName(const std::string& part, ModeSpec& m) {
     m.scheduler.features.useClusters = part != "full-noclusters";
     m.scheduler.features.useClusterHistory = part != "full-noclusterhist";
     m.scheduler.features.useClusterMarks = part == "full-markclusterhist";
+    m.scheduler.features.useClusterWorker = part != "full-noworker";
     return true;
 }
 
@@ -99,7 +100,7 @@ bool applyTwoPhaseName(const std::string& part, ModeSpec& m) {
 std::string modeNamesHelp() {
     return "vfc, simple, full (two-phase: draw last frame's visible parts, test the rest against their depth pyramid, then what it cannot reject in one batched raster test where that pays), "
            "queries (hardware occlusion queries with history, batching and occupancy maps; the default before two-phase), oracle (the visible parts, whole), oracle-clusters (only their clusters that own a pixel); "
-           "ablations of full: full-hzb (the pyramid alone), full-tri (every part whose volume passes then tested on its own triangles, and draws marked), full-nohist (every part drawn early tested again each frame), full-nocost (every volume the pyramid lets through tested), full-noclusters (parts drawn whole, no cluster tests), full-noclusterhist (early parts drawn with all their clusters, not only those that showed last frame), full-markclusterhist (which clusters showed judged by their fragments' marks when drawn, not by their boxes against the final depth); "
+           "ablations of full: full-hzb (the pyramid alone), full-tri (every part whose volume passes then tested on its own triangles, and draws marked), full-nohist (every part drawn early tested again each frame), full-nocost (every volume the pyramid lets through tested), full-noclusters (parts drawn whole, no cluster tests), full-noclusterhist (early parts drawn with all their clusters, not only those that showed last frame), full-markclusterhist (which clusters showed judged by their fragments' marks when drawn, not by their boxes against the final depth), full-noworker (the deferred clusters tested on the render thread as they are drawn, not ahead of them on a worker); "
            "vfc-noclusters (vfc drawing parts whole); "
            "approximate full: budgetP (at most P percent of the frame's pixels lost, e.g. budget0.1), budgetearlyP (and early-set parts showing less than the budget handed to it), budgetrecountP (the parts that could fit drawn last, counted again against the depth of the rest); "
            "settings of queries: approximate thrN (pixel threshold), latency1 (last frame's results), "

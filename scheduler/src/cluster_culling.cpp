@@ -11,7 +11,7 @@
 
 #include <algorithm>
 
-#include "cull_frame.hpp"
+#include "cluster_selection.hpp"
 
 namespace dyncull {
 
@@ -35,6 +35,24 @@ bool QueryScheduler::cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, 
     clusterRanges_.clear();
     clusterRangeIds_.clear();
     lastDeferred_ = 0;
+    ClusterJob job;
+    bool tested = false;
+    if (!planClusters(f, ref, model, n, pass, job, tested)) return false;
+    if (!selection_) selection_ = std::make_unique<ClusterSelection>();
+    ClusterSelection& sel = *selection_;
+    selectClusters(f, job, sel);
+    if (tested) f.stats.clusterTests += static_cast<std::uint32_t>(job.clusters.size());
+    if (!job.split && tested) {
+        const std::uint32_t triangles = n.indexCount / 3;
+        double& rate = clusterCulledRate_[f.objects.modelOf(ref.object)];
+        rate += 0.02 * (double(sel.culledTriangles) / double(triangles > 0 ? triangles : 1) - rate);
+    }
+    takeSelection(f, job, sel);
+    return true;
+}
+
+bool QueryScheduler::planClusters(Frame& f, NodeRef ref, const LocalBsp& model, const LocalBspNode& n, ClusterPass pass,
+                                  ClusterJob& job, bool& tested) {
     if (!params_.features.useClusters || ref.isSceneNode() || !f.sink.drawsRanges() || !model.clusters.builtFor(model.nodes.size()))
         return false;
     const std::span<const LeafCluster> clusters = model.clusters.ofSubtree(ref.node, n.subtreeSize);
@@ -51,9 +69,9 @@ bool QueryScheduler::cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, 
     const bool split = pass != ClusterPass::All;
     const ModelId modelId = objs.modelOf(ref.object);
     if (clusterCulledRate_.size() <= modelId) clusterCulledRate_.resize(modelId + 1, 0.5);
-    double& rate = clusterCulledRate_[modelId];
+    const double rate = clusterCulledRate_[modelId];
     const std::uint32_t triangles = n.indexCount / 3;
-    bool tested = split;
+    tested = split;
     if (!split) {
         // The cost model: a model's clusters are tested while the drawing they were
         // measured to save (its rate of culled triangles) exceeds the tests' cost; one
@@ -66,32 +84,51 @@ bool QueryScheduler::cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, 
         if (!tested && !f.markClusters) return false;
         if (!tested) cones = frustum = pyramid = false;
     }
-
-    const auto t0 = SchedulerClock::now();
     const glm::mat4& matrix = objs.matrix(ref.object);
-    const ObjectProjection object = pyramid ? f.screen.objectProjection(matrix) : ObjectProjection{};
-    const std::span<const std::uint64_t> shown = split ? history_.clusterBits(ref.object, objs) : std::span<const std::uint64_t>{};
-    const std::uint32_t firstCluster = model.clusters.nodeFirst[ref.node];
-    const ObjectSpaceEye eye(f.camera(), matrix);
-    // What the tests culled (less the gaps drawn after all), what is left to the other
-    // pass, and what is drawn; gap*: the run of undrawn clusters since the last drawn one.
-    std::uint64_t culledTriangles = 0, gapTriangles = 0, deferredTriangles = 0, drawnTriangles = 0;
-    std::uint32_t culledClusters = 0, gapClusters = 0, deferred = 0, drawn = 0;
+    job.clusters = clusters;
+    job.firstBit = model.clusters.nodeFirst[ref.node];
+    job.shown = split ? history_.clusterBits(ref.object, objs) : std::span<const std::uint64_t>{};
+    job.matrix = matrix;
+    job.object = pyramid ? f.screen.objectProjection(matrix) : ObjectProjection{};
+    job.eye = ObjectSpaceEye(f.camera(), matrix);
+    job.pass = pass;
+    job.split = split;
+    job.cones = cones;
+    job.frustum = frustum;
+    job.pyramid = pyramid;
+    job.markRanges = f.markClusters;
+    return true;
+}
+
+void QueryScheduler::selectClusters(const Frame& f, const ClusterJob& job, ClusterSelection& out) const {
+    const auto t0 = SchedulerClock::now();
+    out.ranges.clear();
+    out.rangeIds.clear();
+    out.culledTriangles = out.deferredTriangles = out.drawnTriangles = 0;
+    out.culledClusters = out.deferred = out.drawn = 0;
+    const ClusterPass pass = job.pass;
+    const std::uint32_t firstCluster = job.firstBit;
+    const std::span<const LeafCluster> clusters = job.clusters;
+    const DepthPyramid* pyramid = job.pyramid ? &pyramid_ : nullptr;
+    // What the tests culled (less the gaps drawn after all) and, per run of undrawn
+    // clusters since the last drawn one (gap*), what a merged range would draw.
+    std::uint64_t gapTriangles = 0;
+    std::uint32_t gapClusters = 0;
     for (std::uint32_t i = 0; i < clusters.size(); ++i) {
         const LeafCluster& c = clusters[i];
         // Deferred: drawn early already. Early: hidden last frame, left to the late pass
         // if it faces the eye and is in the frustum.
-        const bool otherPass = split && clusterBit(shown, firstCluster + i) == (pass == ClusterPass::Deferred);
+        const bool otherPass = job.split && clusterBit(job.shown, firstCluster + i) == (pass == ClusterPass::Deferred);
         const bool drawnEarly = pass == ClusterPass::Deferred && otherPass;
-        bool culled = !drawnEarly && cones && eye.backFacing(c);
-        if (!drawnEarly && !culled && (frustum || pyramid)) culled = clusterHidden(f, pyramid ? &pyramid_ : nullptr, matrix, object, c, frustum);
+        bool culled = !drawnEarly && job.cones && job.eye.backFacing(c);
+        if (!drawnEarly && !culled && (job.frustum || pyramid)) culled = clusterHidden(f, pyramid, job.matrix, job.object, c, job.frustum);
         if (culled) {
-            ++culledClusters;
-            culledTriangles += c.indexCount / 3;
+            ++out.culledClusters;
+            out.culledTriangles += c.indexCount / 3;
         } else if (otherPass) {
             if (!drawnEarly) {
-                ++deferred;
-                deferredTriangles += c.indexCount / 3;
+                ++out.deferred;
+                out.deferredTriangles += c.indexCount / 3;
             }
         }
         if (culled || otherPass) {
@@ -99,37 +136,41 @@ bool QueryScheduler::cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, 
             gapTriangles += c.indexCount / 3;
             continue;
         }
-        ++drawn;
-        drawnTriangles += c.indexCount / 3;
+        ++out.drawn;
+        out.drawnTriangles += c.indexCount / 3;
         // A gap of culled clusters between two drawn ones costs one more range of the
         // multi-draw: skipped only where it saves more drawing than a range costs, and
         // always when it holds clusters the other pass draws.
-        IndexRange* last = clusterRanges_.empty() ? nullptr : &clusterRanges_.back();
-        if (last && !split && !f.markClusters && double(gapTriangles) * params_.tuning.costs.drawNsPerTriangle < params_.tuning.costs.drawNsPerRange) {
+        IndexRange* last = out.ranges.empty() ? nullptr : &out.ranges.back();
+        if (last && !job.split && !job.markRanges &&
+            double(gapTriangles) * params_.tuning.costs.drawNsPerTriangle < params_.tuning.costs.drawNsPerRange) {
             last->indexCount = c.firstIndex + c.indexCount - last->firstIndex;
-            culledClusters -= gapClusters;  // drawn after all (without a split every gap cluster was culled)
-            culledTriangles -= gapTriangles;
+            out.culledClusters -= gapClusters;  // drawn after all (without a split every gap cluster was culled)
+            out.culledTriangles -= gapTriangles;
         } else {
-            clusterRanges_.push_back({c.firstIndex, c.indexCount});
-            if (f.markClusters) clusterRangeIds_.push_back(firstCluster + i);
+            out.ranges.push_back({c.firstIndex, c.indexCount});
+            if (job.markRanges) out.rangeIds.push_back(firstCluster + i);
         }
         gapClusters = 0;
         gapTriangles = 0;
     }
-    if (tested) f.stats.clusterTests += static_cast<std::uint32_t>(clusters.size());
-    lastDeferred_ = deferred;
-    if (pass == ClusterPass::Early) {
-        f.stats.clustersDeferred += deferred;
-        deferredTriangles_ += deferredTriangles;
-    } else if (pass == ClusterPass::Deferred) {
-        f.stats.deferredClustersDrawn += drawn;
-        deferredTriangles_ -= std::min(deferredTriangles_, drawnTriangles);
+    out.ms = msSince(t0);
+}
+
+void QueryScheduler::takeSelection(Frame& f, const ClusterJob& job, ClusterSelection& sel) {
+    lastDeferred_ = sel.deferred;
+    if (job.pass == ClusterPass::Early) {
+        f.stats.clustersDeferred += sel.deferred;
+        deferredTriangles_ += sel.deferredTriangles;
+    } else if (job.pass == ClusterPass::Deferred) {
+        f.stats.deferredClustersDrawn += sel.drawn;
+        deferredTriangles_ -= std::min(deferredTriangles_, sel.drawnTriangles);
     }
-    f.stats.clustersCulled += culledClusters;
-    f.stats.clusterTrianglesCulled += culledTriangles;
-    if (!split && tested) rate += 0.02 * (double(culledTriangles) / double(triangles > 0 ? triangles : 1) - rate);
-    f.stats.clusterMs += msSince(t0);
-    return true;
+    f.stats.clustersCulled += sel.culledClusters;
+    f.stats.clusterTrianglesCulled += sel.culledTriangles;
+    f.stats.clusterMs += sel.ms;
+    clusterRanges_.swap(sel.ranges);
+    clusterRangeIds_.swap(sel.rangeIds);
 }
 
 }  // namespace dyncull

@@ -9,8 +9,9 @@
 // drawn early, so a wrong bit costs time, never a pixel.
 #include <algorithm>
 #include <cassert>
+#include <system_error>
 
-#include "cull_frame.hpp"
+#include "cluster_selection.hpp"
 
 namespace dyncull {
 
@@ -20,11 +21,67 @@ namespace {
 constexpr int kRecordSpan = 16;
 }  // namespace
 
+void QueryScheduler::startDeferredSelection(Frame& f) {
+    if (!params_.features.useClusterWorker || deferredParts_.empty()) return;
+    if (!deferredSelection_) deferredSelection_ = std::make_unique<DeferredSelection>();
+    DeferredSelection& d = *deferredSelection_;
+    assert(!d.worker.joinable());
+    const SceneObjects& objs = f.objects;
+    d.jobs.resize(deferredParts_.size());
+    d.out.resize(deferredParts_.size());
+    d.bits.clear();
+    std::vector<std::size_t> bitOffsets(deferredParts_.size(), 0);
+    for (std::size_t i = 0; i < deferredParts_.size(); ++i) {
+        const NodeRef ref = deferredParts_[i].ref;
+        const LocalBsp& model = objs.model(objs.modelOf(ref.object));
+        ClusterJob& job = d.jobs[i];
+        bool tested = false;
+        [[maybe_unused]] const bool planned = planClusters(f, ref, model, model.nodes[ref.node], ClusterPass::Deferred, job, tested);
+        assert(planned && "a part that deferred clusters is drawn as clusters");
+        // The words holding its bits, copied: the late pass may grow the history's storage.
+        const std::size_t firstWord = job.firstBit / 64, endWord = (job.firstBit + job.clusters.size() + 63) / 64;
+        bitOffsets[i] = d.bits.size();
+        d.bits.insert(d.bits.end(), job.shown.begin() + static_cast<std::ptrdiff_t>(firstWord),
+                      job.shown.begin() + static_cast<std::ptrdiff_t>(std::min(endWord, job.shown.size())));
+        job.firstBit -= static_cast<std::uint32_t>(64 * firstWord);
+    }
+    for (std::size_t i = 0; i < d.jobs.size(); ++i) {
+        const std::size_t end = i + 1 < d.jobs.size() ? bitOffsets[i + 1] : d.bits.size();
+        d.jobs[i].shown = std::span<const std::uint64_t>(d.bits).subspan(bitOffsets[i], end - bitOffsets[i]);
+    }
+    d.done.store(0, std::memory_order_relaxed);
+    try {
+        d.worker = std::thread([this, &f, &d] {
+            for (std::size_t i = 0; i < d.jobs.size(); ++i) {
+                selectClusters(f, d.jobs[i], d.out[i]);
+                d.done.store(i + 1, std::memory_order_release);
+                d.done.notify_one();
+            }
+        });
+    } catch (const std::system_error&) {
+        // No thread to be had: drawDeferredClusters tests them itself.
+    }
+}
+
+void QueryScheduler::joinDeferredSelection(Frame&) {
+    if (deferredSelection_ && deferredSelection_->worker.joinable()) deferredSelection_->worker.join();
+}
+
 void QueryScheduler::drawDeferredClusters(Frame& f) {
     const SceneObjects& objs = f.objects;
-    for (const DeferredPart& d : deferredParts_) {
-        const LocalBsp& model = objs.model(objs.modelOf(d.ref.object));
-        cullClusters(f, d.ref, model, model.nodes[d.ref.node], ClusterPass::Deferred);
+    // Selected on the worker (if it was started, and could be), which runs ahead of these draws.
+    DeferredSelection* selected = deferredSelection_ && deferredSelection_->worker.joinable() ? deferredSelection_.get() : nullptr;
+    assert(!selected || selected->jobs.size() == deferredParts_.size());
+    for (std::size_t i = 0; i < deferredParts_.size(); ++i) {
+        const DeferredPart& d = deferredParts_[i];
+        if (selected) {
+            selected->waitFor(i);
+            f.stats.clusterTests += static_cast<std::uint32_t>(selected->jobs[i].clusters.size());
+            takeSelection(f, selected->jobs[i], selected->out[i]);
+        } else {
+            const LocalBsp& model = objs.model(objs.modelOf(d.ref.object));
+            cullClusters(f, d.ref, model, model.nodes[d.ref.node], ClusterPass::Deferred);
+        }
         if (clusterRanges_.empty()) {
             // None of its clusters drawn in either pass: it was not drawn.
             if (!d.drawn && d.trace != kInvalidIndex) (*f.trace)[d.trace].state = NodeState::ClusterCulled;
@@ -41,6 +98,7 @@ void QueryScheduler::drawDeferredClusters(Frame& f) {
         f.stats.drawMs += msSince(t0);
         for (const IndexRange& r : clusterRanges_) f.stats.trianglesDrawn += r.indexCount / 3;
     }
+    joinDeferredSelection(f);
 }
 
 void QueryScheduler::recordClusterVisibility(Frame& f) {

@@ -21,6 +21,7 @@ inline double msSince(SchedulerClock::time_point t0) {
 /// in double (affine maps keep which side of a plane a point is on, mirroring included, as
 /// the rasteriser's facing follows the transformed winding).
 struct ObjectSpaceEye {
+    ObjectSpaceEye() = default;
     ObjectSpaceEye(const Camera& camera, const glm::mat4& objectToWorld) : ortho(camera.orthographic()) {
         const glm::dmat4 toObject = glm::inverse(glm::dmat4(objectToWorld));
         eye = glm::dvec3(toObject * glm::dvec4(glm::dvec3(camera.position), 1.0));
@@ -29,8 +30,8 @@ struct ObjectSpaceEye {
     /// True only if every triangle of `c` faces away from the eye (LeafCluster::backFacingFrom).
     bool backFacing(const LeafCluster& c) const { return ortho ? c.backFacingAlong(along) : c.backFacingFrom(eye); }
 
-    bool ortho;
-    glm::dvec3 eye, along;  ///< the eye point, and the view direction (orthographic)
+    bool ortho = false;
+    glm::dvec3 eye{0.0}, along{0.0};  ///< the eye point, and the view direction (orthographic)
 };
 
 struct QueryScheduler::Frame {

@@ -10,7 +10,7 @@
 #include <cassert>
 #include <cmath>
 
-#include "cull_frame.hpp"
+#include "cluster_selection.hpp"
 #include "pending_queries.hpp"
 
 namespace dyncull {

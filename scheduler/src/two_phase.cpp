@@ -28,7 +28,7 @@
 #include <algorithm>
 #include <cassert>
 
-#include "cull_frame.hpp"
+#include "cluster_selection.hpp"
 
 namespace dyncull {
 
@@ -76,6 +76,9 @@ void QueryScheduler::runTwoPhase(Frame& f) {
         f.clusterPyramid = haveDepth;  // the late pass's draws test their clusters against it too
         f.stats.depthReadMs += msSince(t0);
     }
+    // The early parts' deferred clusters depend only on this pyramid: a worker selects
+    // them while the late pass traverses and draws.
+    if (f.clusterPyramid) startDeferredSelection(f);
 
     // 3. Late pass.
     candidates_.clear();
@@ -88,6 +91,7 @@ void QueryScheduler::runTwoPhase(Frame& f) {
     // The early parts' clusters that were hidden last frame, where the pyramid lets them
     // through: drawn before the raster tests, whose depth they make nearer.
     if (!deferredParts_.empty()) drawDeferredClusters(f);
+    joinDeferredSelection(f);  // started with nothing to draw after all: it must not outlive the frame
     if (f.useClusterBits) clusterBitsSavedNs_ = double(deferredTriangles_) * params_.tuning.costs.drawNsPerTriangle;
 
     // 4. The batched raster test, exact per pixel against the early pass's depth, for the

@@ -38,6 +38,8 @@ TEST(BenchModes, AblationsOfFullAndTheirVolumes) {
     EXPECT_FALSE(modeFromName("full")->scheduler.features.useClusterMarks);
     EXPECT_TRUE(modeFromName("full-markclusterhist")->scheduler.features.useClusterMarks);
     EXPECT_TRUE(modeFromName("full-markclusterhist")->scheduler.features.useClusterHistory);
+    EXPECT_TRUE(modeFromName("full")->scheduler.features.useClusterWorker);
+    EXPECT_FALSE(modeFromName("full-noworker")->scheduler.features.useClusterWorker);
     EXPECT_TRUE(modeFromName("vfc")->scheduler.features.useClusters);
     EXPECT_FALSE(modeFromName("vfc-noclusters")->scheduler.features.useClusters);
     EXPECT_EQ(modeFromName("vfc-noclusters")->scheduler.mode, CullMode::Vfc);

@@ -172,6 +172,38 @@ TEST_F(ClusterHistory, EarlyPartsDrawOnlyWhatShowedAndTheImageStaysExact) {
     }
 }
 
+TEST_F(ClusterHistory, TheWorkerDecidesAsTheRenderThreadDoes) {
+    // The late pass's deferred clusters selected on a worker thread (useClusterWorker, the
+    // default) against the same tests on the render thread as each part is drawn (the
+    // reference): the same clusters deferred, culled and drawn, and the same image, every
+    // frame. With the cost model off, nothing else can make the two differ.
+    build({2000, 8, 3.2f, 1.0f, {2.2f, 1.6f, 2.2f}});
+    if (HasFatalFailure()) return;
+    SchedulerParams worker = paramsOf(CullMode::TwoPhase, true), inline_ = worker;
+    ASSERT_TRUE(worker.features.useClusterWorker);
+    inline_.features.useClusterWorker = false;
+    QueryScheduler a(worker), b(inline_);
+    std::uint64_t deferredDrawn = 0;
+    for (int f = 0; f < 24; ++f) {
+        SCOPED_TRACE("frame " + std::to_string(f));
+        circle(0.12f * float(f), 8.0f, 1.0f);
+        Image images[2];
+        const FrameStats x = render(a, images[0]);
+        const FrameStats y = render(b, images[1]);
+        EXPECT_EQ(x.trianglesDrawn, y.trianglesDrawn);
+        EXPECT_EQ(x.partsDrawn, y.partsDrawn);
+        EXPECT_EQ(x.clustersDeferred, y.clustersDeferred);
+        EXPECT_EQ(x.deferredClustersDrawn, y.deferredClustersDrawn);
+        EXPECT_EQ(x.clustersCulled, y.clustersCulled);
+        EXPECT_EQ(x.clusterTrianglesCulled, y.clusterTrianglesCulled);
+        EXPECT_EQ(x.clusterTests, y.clusterTests);
+        EXPECT_EQ(differingPixels(images[0], images[1]), 0u);
+        deferredDrawn += x.deferredClustersDrawn;
+    }
+    EXPECT_GT(deferredDrawn, 0u) << "the late pass drew no deferred cluster: the worker was never compared";
+    EXPECT_EQ(ctx_->checkErrors(), 0u);
+}
+
 TEST_F(ClusterCulling, PixelSizedClustersKeepTheImageExact) {
     // Spheres of one to a few pixels, so that most clusters cover a pixel centre or two, or
     // none: the depth-pyramid tests read only the pixels whose centres a box can cover

@@ -97,7 +97,7 @@ protected:
 TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
     ASSERT_NO_FATAL_FAILURE(build("dyncull_conservative_", 30));
 
-    const char* conservative = "vfc,simple,full,full-hzb,full-nohist,full-nocost,full-tri,full-noclusters,full-noclusterhist,full-markclusterhist,queries,queries-nohist,queries-nobatch,queries-noocc,queries-notight,queries-nodrawq,order,front10,oracle,oracle-clusters,thr64";
+    const char* conservative = "vfc,simple,full,full-hzb,full-nohist,full-nocost,full-tri,full-noclusters,full-noclusterhist,full-markclusterhist,full-noworker,queries,queries-nohist,queries-nobatch,queries-noocc,queries-notight,queries-nodrawq,order,front10,oracle,oracle-clusters,thr64";
     auto modes = cli::modesFromList(conservative);
     ASSERT_TRUE(modes.ok()) << modes.error().message;
     // The test checks culling, not latency: a query that outlasts the default 250 ms bound

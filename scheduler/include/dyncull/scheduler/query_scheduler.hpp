@@ -108,6 +108,11 @@ struct SchedulerFeatures {
     /// lacks it (on issue 21's swarm half the early triangles, 1.3x the triangles in all;
     /// docs/BENCHMARKS.md). An ablation, bench mode full-markclusterhist.
     bool useClusterMarks = false;
+    /// TwoPhase with cluster history: the late pass's deferred clusters are tested on a
+    /// worker thread while the render thread runs the late traversal and its draws (they
+    /// depend only on the early pyramid), instead of part by part as they are drawn. The
+    /// same decisions either way; off: on the render thread (the reference).
+    bool useClusterWorker = true;
     /// TwoPhase (and clusters): test only where SchedulerTuning::costs expects the test to
     /// pay. Off: every volume the pyramid lets through is tested (an ablation).
     bool useCostModel = true;
@@ -477,6 +482,22 @@ private:
     /// clusters: then one range per cluster, its index in clusterRangeIds_); false if the
     /// part is to be drawn whole.
     bool cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, const LocalBspNode& n, ClusterPass pass);
+    // The steps of cullClusters (cluster_selection.hpp): which tests, decided on the render
+    // thread (false: the part is drawn whole); the tests, safe on any thread; their counts
+    // into the stats and cost model.
+    struct ClusterJob;
+    struct ClusterSelection;
+    struct DeferredSelection;
+    bool planClusters(Frame& f, NodeRef ref, const LocalBsp& model, const LocalBspNode& n, ClusterPass pass, ClusterJob& job,
+                      bool& tested);
+    void selectClusters(const Frame& f, const ClusterJob& job, ClusterSelection& out) const;
+    void takeSelection(Frame& f, const ClusterJob& job, ClusterSelection& sel);
+    /// SchedulerFeatures::useClusterWorker: starts selecting the deferred clusters on a
+    /// worker thread (after the early pyramid is built); drawDeferredClusters joins it.
+    void startDeferredSelection(Frame& f);
+    void joinDeferredSelection(Frame& f);
+    std::unique_ptr<DeferredSelection> deferredSelection_;
+    std::unique_ptr<ClusterSelection> selection_;  // cullClusters' scratch
     // useClusterHistory: the parts drawn early that deferred clusters, and every part whose
     // clusters were drawn or tested this frame (their bits are written at the frame's end).
     struct DeferredPart {
