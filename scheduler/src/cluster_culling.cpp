@@ -25,7 +25,7 @@ bool clusterHidden(const QueryScheduler::Frame& f, const DepthPyramid* pyramid, 
     if (frustum && f.frustum().outside(transformAabb(matrix, c.box))) return true;
     if (!pyramid) return false;
     DepthFootprint fp;
-    if (!f.screen.boxDepth(object, matrix, c.box, fp)) return false;
+    if (!f.screen.boxDepth(object, c.box, fp)) return false;
     // A pyramid exists only for a single-sample target: a cluster covering no pixel centre draws nothing.
     return fp.centres.empty() || pyramid->occluded(fp.centres, fp.nearest);
 }
@@ -51,10 +51,13 @@ bool QueryScheduler::cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, 
     return true;
 }
 
+bool QueryScheduler::drawsAsClusters(const Frame& f, NodeRef ref, const LocalBsp& model) const {
+    return params_.features.useClusters && !ref.isSceneNode() && f.sink.drawsRanges() && model.clusters.builtFor(model.nodes.size());
+}
+
 bool QueryScheduler::planClusters(Frame& f, NodeRef ref, const LocalBsp& model, const LocalBspNode& n, ClusterPass pass,
                                   ClusterJob& job, bool& tested) {
-    if (!params_.features.useClusters || ref.isSceneNode() || !f.sink.drawsRanges() || !model.clusters.builtFor(model.nodes.size()))
-        return false;
+    if (!drawsAsClusters(f, ref, model)) return false;
     const std::span<const LeafCluster> clusters = model.clusters.ofSubtree(ref.node, n.subtreeSize);
     if (clusters.empty()) return false;
     const SceneObjects& objs = f.objects;

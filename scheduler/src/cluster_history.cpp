@@ -63,7 +63,7 @@ void QueryScheduler::startDeferredSelection(Frame& f) {
     }
 }
 
-void QueryScheduler::joinDeferredSelection(Frame&) {
+void QueryScheduler::joinDeferredSelection() {
     if (deferredSelection_ && deferredSelection_->worker.joinable()) deferredSelection_->worker.join();
 }
 
@@ -98,7 +98,6 @@ void QueryScheduler::drawDeferredClusters(Frame& f) {
         f.stats.drawMs += msSince(t0);
         for (const IndexRange& r : clusterRanges_) f.stats.trianglesDrawn += r.indexCount / 3;
     }
-    joinDeferredSelection(f);
 }
 
 void QueryScheduler::recordClusterVisibility(Frame& f) {

@@ -128,7 +128,7 @@ ObjectProjection ScreenProjection::objectProjection(const glm::mat4& matrix) con
     return p;
 }
 
-bool ScreenProjection::boxDepth(const ObjectProjection& object, const glm::mat4& matrix, const Aabb& local, DepthFootprint& out) const {
+bool ScreenProjection::boxDepth(const ObjectProjection& object, const Aabb& local, DepthFootprint& out) const {
     // QueryVolume::enlargedForRounding for a box: its vertices' magnitude sets the margin,
     // and each face is pushed out by it through a scale about the centre by k.
     const glm::dvec3 lo(local.min), hi(local.max);
@@ -141,7 +141,8 @@ bool ScreenProjection::boxDepth(const ObjectProjection& object, const glm::mat4&
     const double magnitude = std::max({reach.x, reach.y, reach.z});  // of the farthest corner, per coordinate
     const double push = magnitude * 0x1p-22 * std::sqrt(3.0);
     const double nearest = std::min({half.x * object.faceScale.x, half.y * object.faceScale.y, half.z * object.faceScale.z});
-    if (!(nearest > 4.0 * push)) return volumeDepth(QueryVolume::fromTransformedBox(matrix, local), out);  // thin: as a box of boxes
+    if (!(nearest > 4.0 * push))  // thin: as a box of boxes; the float matrix is toWorld rounded back, exactly
+        return volumeDepth(QueryVolume::fromTransformedBox(glm::mat4(object.toWorld), local), out);
     const double k = 1.0 + push / nearest;
     const glm::dvec3 relCentre = worldCentre - glm::dvec3(view_.camera.position);
     std::array<glm::dvec3, 8> rel;

@@ -28,7 +28,7 @@ struct DepthFootprint {
 /// One object's matrix prepared for the footprints of many boxes in its object space (a
 /// part's clusters): ScreenProjection::boxDepth's per-object terms, computed once. Double.
 struct ObjectProjection {
-    glm::dmat4 toWorld{1.0};  ///< object space to world space
+    glm::dmat4 toWorld{1.0};  ///< object space to world space (the float matrix, exactly)
     /// Per axis i: how far the transformed box's two faces across axis i lie from its centre,
     /// per unit of the box's half extent along i (|det| / |column j x column k| of the
     /// matrix's linear part); 0 for a singular matrix.
@@ -52,13 +52,13 @@ public:
     bool volumeDepth(const QueryVolume& volume, DepthFootprint& out) const;
     /// `matrix` (object to world) prepared for boxDepth.
     ObjectProjection objectProjection(const glm::mat4& matrix) const;
-    /// volumeDepth(QueryVolume::fromTransformedBox(matrix, local), out) for the object that
+    /// volumeDepth(QueryVolume::fromTransformedBox(matrix, local), out) for the matrix that
     /// `object` was prepared from, without building the volume: the box's centre and half
     /// axes are transformed once in double and its corners combined from them, and the
     /// faces' distances come from ObjectProjection::faceScale instead of the 12 triangles.
     /// The same margins for rounding, from the exact corners instead of their float
     /// roundings; a box too thin for them goes through volumeDepth.
-    bool boxDepth(const ObjectProjection& object, const glm::mat4& matrix, const Aabb& local, DepthFootprint& out) const;
+    bool boxDepth(const ObjectProjection& object, const Aabb& local, DepthFootprint& out) const;
     /// A guess, for choices that need no guarantee (cluster history's record of what
     /// showed): the pixels whose centres box `local` under `objectToClip` (object space to
     /// clip space, camera-relative: clipMatrixOf) covers and its nearest window depth, its 8

@@ -91,7 +91,7 @@ void QueryScheduler::runTwoPhase(Frame& f) {
     // The early parts' clusters that were hidden last frame, where the pyramid lets them
     // through: drawn before the raster tests, whose depth they make nearer.
     if (!deferredParts_.empty()) drawDeferredClusters(f);
-    joinDeferredSelection(f);  // started with nothing to draw after all: it must not outlive the frame
+    joinDeferredSelection();  // the worker, done by now, never outlives the late pass
     if (f.useClusterBits) clusterBitsSavedNs_ = double(deferredTriangles_) * params_.tuning.costs.drawNsPerTriangle;
 
     // 4. The batched raster test, exact per pixel against the early pass's depth, for the
@@ -400,8 +400,7 @@ QueryVolume QueryScheduler::testedVolume(const Frame& f, NodeRef ref) const {
     // volume passes, and they bound it tighter than any one volume: a k-DOP's extra
     // triangles then cost every pyramid and raster test and save little, so Auto takes the
     // better of its two boxes (a k-DOP would have to save all of the box's area).
-    const LocalBsp& model = f.objects.model(f.objects.modelOf(ref.object));
-    const bool asClusters = params_.features.useClusters && f.sink.drawsRanges() && model.clusters.builtFor(model.nodes.size());
+    const bool asClusters = drawsAsClusters(f, ref, f.objects.model(f.objects.modelOf(ref.object)));
     return objectNodeVolume(f.objects, ref, params_.tuning.volume, asClusters ? 1.0f : params_.tuning.autoVolumeSaving);
 }
 

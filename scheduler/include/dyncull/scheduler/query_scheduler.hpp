@@ -488,14 +488,18 @@ private:
     struct ClusterJob;
     struct ClusterSelection;
     struct DeferredSelection;
+    /// Whether part `ref` of `model` is drawn as clusters (useClusters, a sink that draws
+    /// ranges, a model with clusters), whatever the tests then decide.
+    bool drawsAsClusters(const Frame& f, NodeRef ref, const LocalBsp& model) const;
     bool planClusters(Frame& f, NodeRef ref, const LocalBsp& model, const LocalBspNode& n, ClusterPass pass, ClusterJob& job,
                       bool& tested);
     void selectClusters(const Frame& f, const ClusterJob& job, ClusterSelection& out) const;
     void takeSelection(Frame& f, const ClusterJob& job, ClusterSelection& sel);
     /// SchedulerFeatures::useClusterWorker: starts selecting the deferred clusters on a
-    /// worker thread (after the early pyramid is built); drawDeferredClusters joins it.
+    /// worker thread (after the early pyramid is built); drawDeferredClusters reads its
+    /// selections as they are written, and joinDeferredSelection ends it with the late pass.
     void startDeferredSelection(Frame& f);
-    void joinDeferredSelection(Frame& f);
+    void joinDeferredSelection();
     std::unique_ptr<DeferredSelection> deferredSelection_;
     std::unique_ptr<ClusterSelection> selection_;  // cullClusters' scratch
     // useClusterHistory: the parts drawn early that deferred clusters, and every part whose
