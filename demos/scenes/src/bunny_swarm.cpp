@@ -48,24 +48,14 @@ public:
 
     Status populate(Engine& engine) override {
         const auto t0 = std::chrono::steady_clock::now();
-        auto choice = findBunnyMesh(o_);
-        if (!choice) return Error{choice.error().message};
-        auto scene = loadScene(choice->path);
-        if (!scene) return Error{scene.error().message};
-        if (scene->meshes.empty()) return Error{choice->path + ": no mesh"};
-        Mesh mesh = std::move(scene->meshes[0]);
-        const std::size_t original = mesh.triangleCount();
-        if (choice->subdivided) mesh = loopSubdivide(mesh, 2);
-        normalise(mesh, o_.bunnySize);
-        const std::size_t triangles = mesh.triangleCount();
-        HoleCapping capped;
-        if (!o_.keepHoles) capped = capHoles(mesh, mesh.indices.size());
+        auto bunny = prepareBunnyMesh(o_);
+        if (!bunny) return Error{bunny.error().message};
         LocalBspParams bspParams;
         bspParams.maxLeafTriangles = o_.leafTriangles;
         bspParams.faces = o_.faces;
         bspParams.optimizeOrder = o_.optimizeOrder;
         bspParams.clusterOrder = o_.clusterOrder;
-        auto model = engine.addModel(mesh, bspParams);
+        auto model = engine.addModel(bunny->mesh, bspParams);
         if (!model) return Error{model.error().message};
         const LocalBsp& bsp = engine.model(*model);
         for (std::uint32_t i = 0; i < o_.count; ++i) {
@@ -73,11 +63,12 @@ public:
             if (!h) return Error{h.error().message};
             handles_.push_back(*h);
         }
-        description_ = "bunny mesh: " + choice->path + " (" + std::to_string(original) + " triangles" +
-                       (choice->subdivided ? ", 2 levels of Loop subdivision -> " + std::to_string(triangles) : std::string()) +
-                       (capped.holes ? ", " + std::to_string(capped.holes) + " holes capped with " +
-                                           std::to_string(capped.triangles) + " triangles"
-                                     : std::string()) +
+        description_ = "bunny mesh: " + bunny->choice.path + " (" + std::to_string(bunny->loadedTriangles) + " triangles" +
+                       (bunny->choice.subdivided ? ", 2 levels of Loop subdivision -> " + std::to_string(bunny->subdividedTriangles)
+                                                 : std::string()) +
+                       (bunny->holesCapped ? ", " + std::to_string(bunny->holesCapped) + " holes capped with " +
+                                                 std::to_string(bunny->cappingTriangles) + " triangles"
+                                           : std::string()) +
                        "; drawn " + (bsp.faces == FaceMode::CullBack ? "with back faces culled" : "two-sided") +
                        "); local BSP: " + std::to_string(bsp.stats.leaves) + " parts, " +
                        std::to_string(bsp.stats.trianglesAfter) + " triangles; " + std::to_string(o_.count) +
@@ -160,6 +151,27 @@ Expected<BunnyMeshChoice> findBunnyMesh(const BunnySwarmOptions& o) {
     if (fs::exists("assets/bunny_npm.ply")) return BunnyMeshChoice{"assets/bunny_npm.ply", true};
     return Error{"no bunny mesh: looked for " + full.string() + " and " + npm.string() +
                  " (run scripts/setup.sh, or pass --mesh PATH or --assets DIR)"};
+}
+
+Expected<BunnyMesh> prepareBunnyMesh(const BunnySwarmOptions& options) {
+    auto choice = findBunnyMesh(options);
+    if (!choice) return Error{choice.error().message};
+    auto scene = loadScene(choice->path);
+    if (!scene) return Error{scene.error().message};
+    if (scene->meshes.empty()) return Error{choice->path + ": no mesh"};
+    BunnyMesh b;
+    b.choice = *choice;
+    b.mesh = std::move(scene->meshes[0]);
+    b.loadedTriangles = b.mesh.triangleCount();
+    if (choice->subdivided) b.mesh = loopSubdivide(b.mesh, 2);
+    normalise(b.mesh, options.bunnySize);
+    b.subdividedTriangles = b.mesh.triangleCount();
+    if (!options.keepHoles) {
+        const HoleCapping capped = capHoles(b.mesh, b.mesh.indices.size());
+        b.holesCapped = capped.holes;
+        b.cappingTriangles = capped.triangles;
+    }
+    return b;
 }
 
 std::unique_ptr<DemoScene> makeBunnySwarm(const BunnySwarmOptions& options) {

@@ -90,6 +90,20 @@ struct BunnyMeshChoice {
 };
 Expected<BunnyMeshChoice> findBunnyMesh(const BunnySwarmOptions& options);
 
+/// The bunny as the swarm hands it to its local BSP, before the split: loaded (findBunnyMesh),
+/// subdivided if the choice says so, centred on the origin with its longest side
+/// `options.bunnySize` (object space of every swarm instance), holes capped unless
+/// `options.keepHoles`. What a peer renderer draws to show the same surface.
+struct BunnyMesh {
+    Mesh mesh;
+    BunnyMeshChoice choice;
+    std::size_t loadedTriangles = 0;      ///< as read from the file
+    std::size_t subdividedTriangles = 0;  ///< after subdivision (= loadedTriangles without it)
+    std::size_t holesCapped = 0;
+    std::size_t cappingTriangles = 0;     ///< triangles the caps added
+};
+Expected<BunnyMesh> prepareBunnyMesh(const BunnySwarmOptions& options);
+
 std::unique_ptr<DemoScene> makeBunnySwarm(const BunnySwarmOptions& options);
 
 /// Any PLY/OBJ/glTF file as a static scene, with an automatic camera path: an orbit
