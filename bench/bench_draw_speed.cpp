@@ -38,6 +38,7 @@
 #include "dyncull/engine/image.hpp"
 #include "dyncull/measure/image_compare.hpp"
 #include "dyncull/objects/checked_write.hpp"
+#include "swarm_bench.hpp"
 #include "shader_program.hpp"  // engine-internal: the engine's own compile-and-link
 
 namespace dyncull {
@@ -245,21 +246,6 @@ public:
     std::uint64_t ranges = 0, parts = 0;  // of the last DrawClusters frame
 };
 
-struct Variant {
-    std::string name;
-    std::string what;
-    std::function<std::uint64_t()> frame;  // draws one frame (finished), returns triangles
-    std::vector<double> ms;
-    std::uint64_t triangles = 0;
-    Image first;
-};
-
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 struct Swarm {
     std::unique_ptr<DemoScene> scene;
     std::unique_ptr<Engine> engine;
@@ -302,31 +288,17 @@ int main(int argc, char** argv) {
     using namespace dyncull;
     keepFreedHeapMemory();  // as the dyncull program does: every variant draws through the same heap
     CLI::App app{"Draw speed of dyncull's renderer against a speed-of-light reference (bunny swarm)"};
-    BunnySwarmOptions o;
-    o.count = 300;
-    o.box = 8.0f;
-    o.bunnySize = 1.0f;
-    o.speed = 0.02f;
-    o.orbit = 12.0f;
-    std::uint32_t frames = 9, first = 0;
-    std::string size = "640x360", out = "out/bench_draw_speed";
-    app.add_option("--frames", frames, "frames measured (every variant draws each)")->check(CLI::Range(1u, 100000u))->capture_default_str();
-    app.add_option("--first", first, "first frame of the swarm's path")->capture_default_str();
-    app.add_option("--count", o.count, "bunnies")->check(CLI::Range(1u, 100000u))->capture_default_str();
-    app.add_option("--box", o.box, "side of the box they move in")->check(CLI::Range(0.01f, 1e6f))->capture_default_str();
-    app.add_option("--bunny-size", o.bunnySize, "longest side of one bunny")->check(CLI::Range(0.001f, 1e5f))->capture_default_str();
-    app.add_option("--speed", o.speed, "world units per frame")->check(CLI::Range(0.0f, 1e4f))->capture_default_str();
-    app.add_option("--orbit", o.orbit, "orbit distance of the camera")->check(CLI::Range(0.01f, 1e7f))->capture_default_str();
+    BunnySwarmOptions o = bench::issue21Swarm();
+    bench::SwarmRun run;
+    run.out = "out/bench_draw_speed";
+    std::string size = "640x360";
+    bench::addSwarmOptions(app, o, run, size);
     app.add_option("--leaf-tris", o.leafTriangles, "local-BSP leaf size")->check(CLI::Range(1u, 100000000u))->capture_default_str();
-    app.add_option("--mesh", o.meshPath, "mesh file instead of the asset directory's bunny");
-    app.add_option("--size", size, "framebuffer WxH")->capture_default_str();
-    app.add_option("--out", out, "output directory")->capture_default_str();
-    std::string only;
-    app.add_option("--only", only, "comma-separated variants to run (default all), e.g. to profile one");
     CLI11_PARSE(app, argc, argv);
-    int width = 0, height = 0;
-    if (std::sscanf(size.c_str(), "%dx%d", &width, &height) != 2 || width < 1 || height < 1 || width > 16384 || height > 16384)
-        fail("--size: expected WxH, e.g. 640x360");
+    if (!bench::parseSize(size, run)) fail("--size: expected WxH, e.g. 640x360");
+    const std::uint32_t frames = run.frames, first = run.first;
+    const int width = run.width, height = run.height;
+    const std::string& out = run.out;
 
     ContextOptions co;
     co.width = width;
@@ -355,7 +327,7 @@ int main(int argc, char** argv) {
                 culls ? "with back faces culled (closed and outward)" : "two-sided (FacePolicy::Auto: not closed)");
     SpeedOfLight sol(*tuned.engine);
 
-    std::vector<Variant> variants;
+    std::vector<bench::Variant> variants;
     auto finished = [](auto&& draw) {
         return [draw]() -> std::uint64_t {
             glFinish();
@@ -443,11 +415,7 @@ int main(int argc, char** argv) {
     variants.push_back({"vfc-before", "the renderer before issue 21: per-pixel, two-sided, load order, whole parts",
                         vfcFrame(unordered, Shading::Pixel, false, false, false), {}, 0, {}});
 
-    if (!only.empty()) {
-        const std::string list = "," + only + ",";
-        std::erase_if(variants, [&](const Variant& v) { return list.find("," + v.name + ",") == std::string::npos; });
-        if (variants.empty()) fail("--only: no such variant in '" + only + "'");
-    }
+    if (!bench::keepOnly(variants, run.only)) fail("--only: no such variant in '" + run.only + "'");
     std::vector<Swarm*> swarms{&tuned, &unordered, &noMeshlets};
     if (forced) swarms.push_back(forced.get());
     const float aspect = static_cast<float>(width) / static_cast<float>(height);
@@ -462,7 +430,7 @@ int main(int argc, char** argv) {
         }
         // Rotate the order every frame so no variant always runs right after the same one.
         for (std::size_t k = 0; k < variants.size(); ++k) {
-            Variant& v = variants[(k + static_cast<std::size_t>(f + 1)) % variants.size()];
+            bench::Variant& v = variants[(k + static_cast<std::size_t>(f + 1)) % variants.size()];
             const auto t0 = Clock::now();
             v.triangles = v.frame();
             const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
@@ -480,11 +448,11 @@ int main(int argc, char** argv) {
     const std::filesystem::path csvPath = std::filesystem::path(out) / "draw_speed.csv";
     if (Status s = openChecked(csv, csvPath); !s) fail(s.message());
     csv << "variant,median_ms,mean_ms,frames,triangles,ns_per_triangle,vs_sol\n";
-    const double solMs = median(variants[0].ms);
+    const double solMs = bench::median(variants[0].ms);
     std::printf("%-18s %9s %9s %11s %8s %7s  %s\n", "variant", "median_ms", "mean_ms", "triangles", "ns/tri", "vs_sol",
                 "what");
-    for (const Variant& v : variants) {
-        const double med = median(v.ms);
+    for (const bench::Variant& v : variants) {
+        const double med = bench::median(v.ms);
         double mean = 0;
         for (double x : v.ms) mean += x / static_cast<double>(v.ms.size());
         const double nsPerTri = v.triangles ? 1e6 * med / static_cast<double>(v.triangles) : 0.0;
@@ -501,15 +469,15 @@ int main(int argc, char** argv) {
     // What one more range of a multi-draw costs: drawing every part as its clusters'
     // ranges against drawing it as one range, the same triangles.
     const auto named = [&](const char* n) {
-        return std::find_if(variants.begin(), variants.end(), [&](const Variant& v) { return v.name == n; });
+        return std::find_if(variants.begin(), variants.end(), [&](const bench::Variant& v) { return v.name == n; });
     };
     if (named("parts") != variants.end() && named("parts-clusters") != variants.end() && parts.ranges > parts.parts)
         std::printf("a range of a multi-draw costs %.2f us (parts-clusters against parts, %llu ranges for %llu parts)\n",
-                    1000.0 * (median(named("parts-clusters")->ms) - median(named("parts")->ms)) / double(parts.ranges - parts.parts),
+                    1000.0 * (bench::median(named("parts-clusters")->ms) - bench::median(named("parts")->ms)) / double(parts.ranges - parts.parts),
                     static_cast<unsigned long long>(parts.ranges), static_cast<unsigned long long>(parts.parts));
-    const auto vfc = std::find_if(variants.begin(), variants.end(), [](const Variant& v) { return v.name == "vfc"; });
+    const auto vfc = std::find_if(variants.begin(), variants.end(), [](const bench::Variant& v) { return v.name == "vfc"; });
     const Image& ref = vfc != variants.end() ? vfc->first : variants[0].first;
-    for (const Variant& v : variants)
+    for (const bench::Variant& v : variants)
         if (!v.first.rgba.empty() && &v.first != &ref && v.name.rfind("sol", 0) != 0)
             if (auto d = compareImages(ref, v.first))
                 std::printf("pixels differing from vfc, frame %u: %-16s %llu (%.3f%%)\n", first, v.name.c_str(),

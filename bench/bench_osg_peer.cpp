@@ -52,6 +52,7 @@
 #include "dyncull/measure/png_writer.hpp"
 #include "dyncull/objects/checked_write.hpp"
 #include "dyncull/objects/mesh.hpp"
+#include "swarm_bench.hpp"
 
 namespace dyncull {
 namespace {
@@ -198,21 +199,6 @@ void setOsgCamera(osgViewer::Viewer& viewer, const Camera& c) {
                                           double(c.farPlane));
 }
 
-struct Variant {
-    std::string name;
-    std::string what;
-    std::function<std::uint64_t()> frame;  // draws one frame, returns triangles
-    std::vector<double> ms;
-    std::uint64_t triangles = 0;
-    Image first;
-};
-
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 }  // namespace
 }  // namespace dyncull
 
@@ -220,29 +206,16 @@ int main(int argc, char** argv) {
     using namespace dyncull;
     keepFreedHeapMemory();  // one process: OSG's frames draw through the same heap as dyncull's
     CLI::App app{"OpenSceneGraph beside dyncull on the bunny swarm, interleaved per frame in one context"};
-    BunnySwarmOptions o;
-    o.count = 300;
-    o.box = 8.0f;
-    o.bunnySize = 1.0f;
-    o.speed = 0.02f;
-    o.orbit = 12.0f;
-    std::uint32_t frames = 9, first = 0;
-    std::string size = "640x360", out = "out/bench_osg_peer", only;
-    app.add_option("--frames", frames, "frames measured (every variant draws each)")->check(CLI::Range(1u, 100000u))->capture_default_str();
-    app.add_option("--first", first, "first frame of the swarm's path")->capture_default_str();
-    app.add_option("--count", o.count, "bunnies")->check(CLI::Range(1u, 100000u))->capture_default_str();
-    app.add_option("--box", o.box, "side of the box they move in")->check(CLI::Range(0.01f, 1e6f))->capture_default_str();
-    app.add_option("--bunny-size", o.bunnySize, "longest side of one bunny")->check(CLI::Range(0.001f, 1e5f))->capture_default_str();
-    app.add_option("--speed", o.speed, "world units per frame")->check(CLI::Range(0.0f, 1e4f))->capture_default_str();
-    app.add_option("--orbit", o.orbit, "orbit distance of the camera")->check(CLI::Range(0.01f, 1e7f))->capture_default_str();
-    app.add_option("--mesh", o.meshPath, "mesh file instead of the asset directory's bunny");
-    app.add_option("--size", size, "framebuffer WxH")->capture_default_str();
-    app.add_option("--out", out, "output directory")->capture_default_str();
-    app.add_option("--only", only, "comma-separated variants to run (default all)");
+    BunnySwarmOptions o = bench::issue21Swarm();
+    bench::SwarmRun run;
+    run.out = "out/bench_osg_peer";
+    std::string size = "640x360";
+    bench::addSwarmOptions(app, o, run, size);
     CLI11_PARSE(app, argc, argv);
-    int width = 0, height = 0;
-    if (std::sscanf(size.c_str(), "%dx%d", &width, &height) != 2 || width < 1 || height < 1 || width > 16384 || height > 16384)
-        fail("--size: expected WxH, e.g. 640x360");
+    if (!bench::parseSize(size, run)) fail("--size: expected WxH, e.g. 640x360");
+    const std::uint32_t frames = run.frames, first = run.first;
+    const int width = run.width, height = run.height;
+    const std::string& out = run.out;
 
     createCompatibilityContext();
     const Framebuffer target(width, height);
@@ -304,7 +277,7 @@ int main(int argc, char** argv) {
             return st->trianglesDrawn;
         };
     };
-    std::vector<Variant> variants;
+    std::vector<bench::Variant> variants;
     variants.push_back({"osg", "OpenSceneGraph 3.6: frustum culling, both faces, per-vertex headlight",
                         osgFrame(OsgScene::Plain), {}, 0, {}});
     variants.push_back({"osg-cull", "osg with back faces culled", osgFrame(OsgScene::CullBack), {}, 0, {}});
@@ -312,11 +285,7 @@ int main(int argc, char** argv) {
                         osgFrame(OsgScene::Queried), {}, 0, {}});
     variants.push_back({"vfc", "dyncull vfc", dyncullFrame(vfc), {}, 0, {}});
     variants.push_back({"full", "dyncull's default conservative mode, its history from frame to frame", dyncullFrame(full), {}, 0, {}});
-    if (!only.empty()) {
-        const std::string list = "," + only + ",";
-        std::erase_if(variants, [&](const Variant& v) { return list.find("," + v.name + ",") == std::string::npos; });
-        if (variants.empty()) fail("--only: no such variant in '" + only + "'");
-    }
+    if (!bench::keepOnly(variants, run.only)) fail("--only: no such variant in '" + run.only + "'");
 
     const float aspect = static_cast<float>(width) / static_cast<float>(height);
     // Frame -1 is a warm-up: llvmpipe compiles shader and state variants on first use.
@@ -330,7 +299,7 @@ int main(int argc, char** argv) {
         setOsgCamera(viewer, camera);
         // Rotate the order every frame so no variant always runs right after the same one.
         for (std::size_t k = 0; k < variants.size(); ++k) {
-            Variant& v = variants[(k + static_cast<std::size_t>(f + 1)) % variants.size()];
+            bench::Variant& v = variants[(k + static_cast<std::size_t>(f + 1)) % variants.size()];
             glFinish();
             const auto t0 = Clock::now();
             v.triangles = v.frame();
@@ -351,12 +320,12 @@ int main(int argc, char** argv) {
     const std::filesystem::path csvPath = std::filesystem::path(out) / "osg_peer.csv";
     if (Status s = openChecked(csv, csvPath); !s) fail(s.message());
     csv << "variant,median_ms,mean_ms,frames,triangles,vs_osg,per_frame_vs_osg\n";
-    const auto osgIt = std::find_if(variants.begin(), variants.end(), [](const Variant& v) { return v.name == "osg"; });
-    const double osgMs = osgIt != variants.end() ? median(osgIt->ms) : 0.0;
+    const auto osgIt = std::find_if(variants.begin(), variants.end(), [](const bench::Variant& v) { return v.name == "osg"; });
+    const double osgMs = osgIt != variants.end() ? bench::median(osgIt->ms) : 0.0;
     std::printf("%-9s %9s %9s %11s %7s %9s  %s\n", "variant", "median_ms", "mean_ms", "triangles", "vs_osg", "per_frame",
                 "what");
-    for (const Variant& v : variants) {
-        const double med = median(v.ms);
+    for (const bench::Variant& v : variants) {
+        const double med = bench::median(v.ms);
         double mean = 0;
         for (double x : v.ms) mean += x / static_cast<double>(v.ms.size());
         const double ratio = osgMs > 0 ? med / osgMs : 0.0;
@@ -364,7 +333,7 @@ int main(int argc, char** argv) {
         std::vector<double> perFrame;
         if (osgIt != variants.end())
             for (std::size_t i = 0; i < v.ms.size(); ++i) perFrame.push_back(v.ms[i] / osgIt->ms[i]);
-        const double frameRatio = perFrame.empty() ? 0.0 : median(perFrame);
+        const double frameRatio = perFrame.empty() ? 0.0 : bench::median(perFrame);
         std::printf("%-9s %9.1f %9.1f %11llu %7.3f %9.3f  %s\n", v.name.c_str(), med, mean,
                     static_cast<unsigned long long>(v.triangles), ratio, frameRatio, v.what.c_str());
         csv << v.name << ',' << med << ',' << mean << ',' << v.ms.size() << ',' << v.triangles << ',' << ratio << ','
@@ -374,7 +343,7 @@ int main(int argc, char** argv) {
     if (Status s = closeChecked(csv, csvPath); !s) fail(s.message());
     // The same scene: the pixels covered (not the clear colour) in the first frame must agree
     // between OSG and dyncull; the shading differs by design.
-    const auto vfcIt = std::find_if(variants.begin(), variants.end(), [](const Variant& v) { return v.name == "vfc"; });
+    const auto vfcIt = std::find_if(variants.begin(), variants.end(), [](const bench::Variant& v) { return v.name == "vfc"; });
     if (osgIt != variants.end() && vfcIt != variants.end()) {
         const glm::u8vec4 clear(glm::round(Renderer::kClearColour * 255.0f), 255);
         std::uint64_t covered = 0, differ = 0;
