@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <string_view>
 
+#include "dyncull/measure/budget_oracle.hpp"
 #include "dyncull/measure/png_writer.hpp"
 #include "dyncull/bsp/traversal.hpp"
 #include "dyncull/engine/gl_context.hpp"
@@ -99,7 +100,8 @@ bool applyTwoPhaseName(const std::string& part, ModeSpec& m) {
 
 std::string modeNamesHelp() {
     return "vfc, simple, full (two-phase: draw last frame's visible parts, test the rest against their depth pyramid, then what it cannot reject in one batched raster test where that pays), "
-           "queries (hardware occlusion queries with history, batching and occupancy maps; the default before two-phase), oracle (the visible parts, whole), oracle-clusters (only their clusters that own a pixel); "
+           "queries (hardware occlusion queries with history, batching and occupancy maps; the default before two-phase), oracle (the visible parts, whole), oracle-clusters (only their clusters that own a pixel), "
+           "oracle-budgetP (oracle-clusters less what an oracle with a budget of P% of the pixels leaves out); "
            "ablations of full: full-hzb (the pyramid alone), full-tri (every part whose volume passes then tested on its own triangles, and draws marked), full-nohist (every part drawn early tested again each frame), full-nocost (every volume the pyramid lets through tested), full-noclusters (parts drawn whole, no cluster tests), full-noclusterhist (early parts drawn with all their clusters, not only those that showed last frame), full-markclusterhist (which clusters showed judged by their fragments' marks when drawn, not by their boxes against the final depth), full-noworker (the deferred clusters tested on the render thread as they are drawn, not ahead of them on a worker); "
            "vfc-noclusters (vfc drawing parts whole); "
            "approximate full: budgetP (at most P percent of the frame's pixels lost, e.g. budget0.1), budgetearlyP (and early-set parts showing less than the budget handed to it), budgetrecountP (the parts that could fit drawn last, counted again against the depth of the rest); "
@@ -242,6 +244,10 @@ Expected<ModeSpec> modeFromName(const std::string& name) {
     } else if (name == "oracle" || name == "oracle-clusters") {
         m.oracle = true;
         m.oracleClusters = name == "oracle-clusters";
+    } else if (double budget = 0.0; percentAfter(name, "oracle-budget", budget)) {
+        if (!(budget > 0.0)) return Error{"--modes: '" + name + "': the budget must be above 0"};
+        m.oracle = m.oracleClusters = true;
+        m.oracleBudgetPercent = budget;
     } else {
         // `full` or one of its ablations, or settings of `queries`, combined with '+'
         // (thr16+latency1); at most one part is a volume.
@@ -380,6 +386,34 @@ Expected<std::unique_ptr<BenchRunner>> BenchRunner::create(Engine& engine, DemoS
     return r;
 }
 
+void BenchRunner::oracleRanges(std::span<const std::uint8_t> droppedClusters, std::span<const std::uint8_t> droppedParts,
+                               std::vector<PartRange>& out) const {
+    out.clear();
+    if (truth_.clusterFirst.empty()) return;
+    for (const NodeRef& ref : oracleParts_) {
+        const LocalBsp& model = engine_.objects().model(engine_.objects().modelOf(ref.object));
+        const auto at = std::lower_bound(truth_.parts.begin(), truth_.parts.end(), ref);
+        const auto i = static_cast<std::size_t>(at - truth_.parts.begin());
+        const std::size_t first = truth_.clusterFirst[i], last = truth_.clusterFirst[i + 1];
+        if (first == last) {  // no clusters: the whole part
+            if (!droppedParts.empty() && droppedParts[i]) continue;
+            const LocalBspNode& n = model.nodes[ref.node];
+            out.push_back({ref, n.firstIndex, n.indexCount});
+            continue;
+        }
+        const std::size_t start = out.size();
+        for (std::size_t c = first; c < last; ++c) {
+            if (!droppedClusters.empty() && droppedClusters[c]) continue;
+            const LeafCluster& cl = model.clusters.clusters[truth_.clusters[c]];
+            PartRange* prev = out.size() > start ? &out.back() : nullptr;
+            if (prev && prev->firstIndex + prev->indexCount == cl.firstIndex)
+                prev->indexCount += cl.indexCount;
+            else
+                out.push_back({ref, cl.firstIndex, cl.indexCount});
+        }
+    }
+}
+
 Status BenchRunner::runFrame(std::uint64_t frame) {
     const glm::ivec2 size = engine_.context().size();
     const float aspect = static_cast<float>(size.x) / static_cast<float>(size.y);
@@ -413,27 +447,37 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
     std::sort(byDistance.begin(), byDistance.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
     oracleParts_.clear();
     for (const auto& p : byDistance) oracleParts_.push_back(p.second);
-    oracleClusterRanges_.clear();
     // Only where a mode draws them (GroundTruth::setClusterIds): each part's visible clusters.
-    for (const NodeRef& ref : truth_.clusterFirst.empty() ? std::span<const NodeRef>{} : std::span<const NodeRef>(oracleParts_)) {
-        const LocalBsp& model = engine_.objects().model(engine_.objects().modelOf(ref.object));
-        const auto at = std::lower_bound(truth_.parts.begin(), truth_.parts.end(), ref);
-        const auto i = static_cast<std::size_t>(at - truth_.parts.begin());
-        const std::size_t first = truth_.clusterFirst[i], last = truth_.clusterFirst[i + 1];
-        if (first == last) {  // no clusters: the whole part
-            const LocalBspNode& n = model.nodes[ref.node];
-            oracleClusterRanges_.push_back({ref, n.firstIndex, n.indexCount});
-            continue;
+    oracleRanges({}, {}, oracleClusterRanges_);
+    oracleBudgetRanges_.resize(result_.modes.size());
+    oracleBudgetPixels_.assign(result_.modes.size(), 0);
+    for (std::size_t m = 0; m < result_.modes.size(); ++m) {
+        const double percent = result_.modes[m].oracleBudgetPercent;
+        if (percent <= 0.0 || truth_.clusterFirst.empty()) continue;
+        itemTriangles_.clear();
+        itemPixels_.clear();
+        for (std::size_t i = 0; i < truth_.parts.size(); ++i) {
+            const LocalBsp& model = engine_.objects().model(engine_.objects().modelOf(truth_.parts[i].object));
+            for (std::size_t c = truth_.clusterFirst[i]; c < truth_.clusterFirst[i + 1]; ++c) {
+                itemTriangles_.push_back(model.clusters.clusters[truth_.clusters[c]].indexCount / 3);
+                itemPixels_.push_back(truth_.clusterPixels[c]);
+            }
         }
-        const std::size_t start = oracleClusterRanges_.size();
-        for (std::size_t c = first; c < last; ++c) {
-            const LeafCluster& cl = model.clusters.clusters[truth_.clusters[c]];
-            PartRange* prev = oracleClusterRanges_.size() > start ? &oracleClusterRanges_.back() : nullptr;
-            if (prev && prev->firstIndex + prev->indexCount == cl.firstIndex)
-                prev->indexCount += cl.indexCount;
-            else
-                oracleClusterRanges_.push_back({ref, cl.firstIndex, cl.indexCount});
+        std::vector<std::uint32_t> wholeParts;  // visible parts without clusters: items after the clusters
+        for (std::size_t i = 0; i < truth_.parts.size(); ++i) {
+            if (truth_.clusterFirst[i] != truth_.clusterFirst[i + 1]) continue;
+            wholeParts.push_back(static_cast<std::uint32_t>(i));
+            itemTriangles_.push_back(engine_.objects().model(engine_.objects().modelOf(truth_.parts[i].object)).nodes[truth_.parts[i].node].indexCount / 3);
+            itemPixels_.push_back(truth_.pixels[i]);
         }
+        const auto budgetPixels = static_cast<std::uint64_t>(percent / 100.0 * double(engine_.context().size().x) *
+                                                             double(engine_.context().size().y));
+        BudgetDrops drops = chooseBudgetDrops(itemTriangles_, itemPixels_, budgetPixels);
+        std::vector<std::uint8_t> droppedParts(truth_.parts.size(), 0);
+        for (std::size_t k = 0; k < wholeParts.size(); ++k) droppedParts[wholeParts[k]] = drops.dropped[truth_.clusters.size() + k];
+        drops.dropped.resize(truth_.clusters.size());
+        oracleRanges(drops.dropped, droppedParts, oracleBudgetRanges_[m]);
+        oracleBudgetPixels_[m] = drops.pixels;
     }
 
     std::vector<ModeFrame> row(result_.modes.size());
@@ -450,7 +494,8 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
         // The reference image is complete even where the scene may skip work (streamed
         // leaves not yet read), so what a mode skips counts as its error.
         scene_.setReferencePass(m == 0);
-        auto rendered = spec.oracleClusters ? engine_.renderPartRanges(oracleClusterRanges_)
+        auto rendered = spec.oracleBudgetPercent > 0 ? engine_.renderPartRanges(oracleBudgetRanges_[m])
+                        : spec.oracleClusters         ? engine_.renderPartRanges(oracleClusterRanges_)
                         : spec.oracle       ? engine_.renderParts(oracleParts_)
                                             : engine_.renderFrame(*schedulers_[m]);
         scene_.setReferencePass(false);
@@ -459,6 +504,7 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
             return Error{"frame " + std::to_string(frame) + ", mode " + spec.name + ": " + rendered.error().message};
         }
         row[m].stats = *rendered;
+        if (spec.oracleBudgetPercent > 0) row[m].stats.claimedErrorPixels = oracleBudgetPixels_[m];
         const std::vector<NodeRef> drawn = drawnLeaves(engine_.objects(), engine_.visibleParts());
         row[m].parts = compareParts(truth_, drawn);
         images_[m] = engine_.renderer().readPixels();

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,10 @@ struct ModeSpec {
     /// With `oracle`: draws only the clusters of the visible parts that own a pixel (the
     /// floor of a culler at cluster granularity), not the visible parts whole.
     bool oracleClusters = false;
+    /// oracle-budgetP (> 0, percent of the frame's pixels): the oracle-clusters set less the
+    /// visible clusters an oracle with that error budget leaves out (chooseBudgetDrops):
+    /// the floor of any error-budget culler at cluster granularity.
+    double oracleBudgetPercent = 0.0;
     SchedulerParams scheduler;
     GlQueryParams queries;
     /// The family of settings this mode belongs to, one curve in the speed-accuracy plot:
@@ -47,7 +52,8 @@ std::string approximationFamily(const ModeSpec& m);
 /// A named mode: vfc, simple, full (two-phase, the default), queries (hardware queries),
 /// oracle; ablations of full: full-hzb, full-nohist, full-nocost; approximate full:
 /// budgetP (error budget of P percent of the frame's pixels) and its variants budgetrecountP,
-/// budgetearlyP; settings of queries:
+/// budgetearlyP; oracle-budgetP (oracle-clusters less what an oracle with that error budget
+/// leaves out); settings of queries:
 /// approximate presets thrN (pixel threshold N), latency1 (last frame's results), skipN
 /// (history: max skip N, 2 frames per visible answer), overlap (overlapping batches),
 /// smallN (small-feature culling below N pixels); frontN (conservative: the front-most N%
@@ -170,6 +176,15 @@ private:
     std::vector<Image> images_;
     std::vector<NodeRef> oracleParts_;
     std::vector<PartRange> oracleClusterRanges_;  // oracle-clusters: oracleParts_' visible clusters, adjacent ones merged
+    std::vector<std::vector<PartRange>> oracleBudgetRanges_;  // per mode: oracle-budgetP's ranges (empty for other modes)
+    std::vector<std::uint64_t> oracleBudgetPixels_;           // per mode: the pixels its ranges leave out this frame
+    std::vector<std::uint32_t> itemTriangles_, itemPixels_;   // the budget oracle's items: visible clusters, then clusterless parts
+
+    /// oracleParts_' visible clusters (whole parts where they have none) as ranges in `out`,
+    /// adjacent ones merged, less those marked dropped (per truth_.clusters, and per
+    /// truth_.parts for parts without clusters; empty spans drop nothing).
+    void oracleRanges(std::span<const std::uint8_t> droppedClusters, std::span<const std::uint8_t> droppedParts,
+                      std::vector<PartRange>& out) const;
     std::vector<NodeTrace> trace_;
     bool measureBound_ = false;
     std::vector<std::vector<NodeRef>> missing_;  // per mode: last frame's visible parts not drawn

@@ -14,6 +14,12 @@ TEST(BenchModes, BaseModes) {
     EXPECT_TRUE(modeFromName("oracle")->oracle);
     EXPECT_FALSE(modeFromName("oracle")->oracleClusters);
     EXPECT_TRUE(modeFromName("oracle-clusters")->oracle && modeFromName("oracle-clusters")->oracleClusters);
+    EXPECT_EQ(modeFromName("oracle-clusters")->oracleBudgetPercent, 0.0);
+    const ModeSpec budgetOracle = modeFromName("oracle-budget0.1").take();
+    EXPECT_TRUE(budgetOracle.oracle && budgetOracle.oracleClusters);
+    EXPECT_DOUBLE_EQ(budgetOracle.oracleBudgetPercent, 0.1);
+    EXPECT_FALSE(modeFromName("oracle-budget0"));
+    EXPECT_FALSE(modeFromName("oracle-budget"));
     const ModeSpec full = modeFromName("full").take();
     EXPECT_EQ(full.scheduler.mode, CullMode::TwoPhase);
     EXPECT_TRUE(full.scheduler.features.useBatchedRaster && full.scheduler.features.useCostModel && full.scheduler.features.useHistory);

@@ -310,11 +310,11 @@ void GroundTruth::visibleClusters(const SceneObjects& objects, std::span<const s
         const auto c = static_cast<std::uint32_t>(model.clusters.nodeFirst[ref.node] + (after - 1 - clusters.begin()));
         clusterKeys_.push_back(std::uint64_t{id - 1} << 32 | c);
     }
-    std::sort(clusterKeys_.begin(), clusterKeys_.end());
-    clusterKeys_.erase(std::unique(clusterKeys_.begin(), clusterKeys_.end()), clusterKeys_.end());
+    std::sort(clusterKeys_.begin(), clusterKeys_.end());  // one key per pixel: a run of equal keys is a cluster's pixels
     // Visible parts are the candidates with pixels, in candidate order, as are the keys.
     vs.clusterFirst.assign(1, 0);
     vs.clusters.clear();
+    vs.clusterPixels.clear();
     vs.visibleClusterTriangles = 0;
     std::size_t key = 0;
     for (std::size_t p = 0; p < vs.parts.size(); ++p) {
@@ -322,10 +322,15 @@ void GroundTruth::visibleClusters(const SceneObjects& objects, std::span<const s
         while (key < clusterKeys_.size() && candidates_[clusterKeys_[key] >> 32] < ref) ++key;
         const LocalBsp& model = objects.model(objects.modelOf(ref.object));
         const std::size_t before = vs.clusters.size();
-        for (; key < clusterKeys_.size() && candidates_[clusterKeys_[key] >> 32] == ref; ++key) {
-            const auto c = static_cast<std::uint32_t>(clusterKeys_[key] & 0xffffffffu);
+        while (key < clusterKeys_.size() && candidates_[clusterKeys_[key] >> 32] == ref) {
+            const std::uint64_t k = clusterKeys_[key];
+            const std::size_t end = static_cast<std::size_t>(
+                std::upper_bound(clusterKeys_.begin() + static_cast<std::ptrdiff_t>(key), clusterKeys_.end(), k) - clusterKeys_.begin());
+            const auto c = static_cast<std::uint32_t>(k & 0xffffffffu);
             vs.clusters.push_back(c);
+            vs.clusterPixels.push_back(static_cast<std::uint32_t>(end - key));
             vs.visibleClusterTriangles += model.clusters.clusters[c].indexCount / 3;
+            key = end;
         }
         if (vs.clusters.size() == before) vs.visibleClusterTriangles += model.nodes[ref.node].indexCount / 3;  // no clusters: the whole part
         vs.clusterFirst.push_back(static_cast<std::uint32_t>(vs.clusters.size()));

@@ -39,6 +39,7 @@ struct VisibleSet {
     /// (its pixels are the part's alone). clusterFirst has parts.size() + 1 entries.
     std::vector<std::uint32_t> clusterFirst;  ///< empty unless GroundTruth::setClusterIds
     std::vector<std::uint32_t> clusters;
+    std::vector<std::uint32_t> clusterPixels;  ///< clusterPixels[k]: pixels clusters[k] owns (> 0)
     /// Triangles of those clusters, plus the whole triangles of visible parts without
     /// clusters: what a culler at cluster granularity must draw at least.
     std::uint64_t visibleClusterTriangles = 0;
