@@ -451,11 +451,13 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
     oracleRanges({}, {}, oracleClusterRanges_);
     oracleBudgetRanges_.resize(result_.modes.size());
     oracleBudgetPixels_.assign(result_.modes.size(), 0);
-    for (std::size_t m = 0; m < result_.modes.size(); ++m) {
-        const double percent = result_.modes[m].oracleBudgetPercent;
-        if (percent <= 0.0 || truth_.clusterFirst.empty()) continue;
+    const bool budgetOracle = std::any_of(result_.modes.begin(), result_.modes.end(), [](const ModeSpec& m) { return m.oracleBudgetPercent > 0; });
+    if (budgetOracle && !truth_.clusterFirst.empty()) {
+        // The budget oracle's items, the same for every budget: the visible clusters, then
+        // the visible parts without clusters, each with its triangles and own pixels.
         itemTriangles_.clear();
         itemPixels_.clear();
+        itemWholeParts_.clear();
         for (std::size_t i = 0; i < truth_.parts.size(); ++i) {
             const LocalBsp& model = engine_.objects().model(engine_.objects().modelOf(truth_.parts[i].object));
             for (std::size_t c = truth_.clusterFirst[i]; c < truth_.clusterFirst[i + 1]; ++c) {
@@ -463,21 +465,23 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
                 itemPixels_.push_back(truth_.clusterPixels[c]);
             }
         }
-        std::vector<std::uint32_t> wholeParts;  // visible parts without clusters: items after the clusters
         for (std::size_t i = 0; i < truth_.parts.size(); ++i) {
             if (truth_.clusterFirst[i] != truth_.clusterFirst[i + 1]) continue;
-            wholeParts.push_back(static_cast<std::uint32_t>(i));
+            itemWholeParts_.push_back(static_cast<std::uint32_t>(i));
             itemTriangles_.push_back(engine_.objects().model(engine_.objects().modelOf(truth_.parts[i].object)).nodes[truth_.parts[i].node].indexCount / 3);
             itemPixels_.push_back(truth_.pixels[i]);
         }
-        const auto budgetPixels = static_cast<std::uint64_t>(percent / 100.0 * double(engine_.context().size().x) *
-                                                             double(engine_.context().size().y));
-        BudgetDrops drops = chooseBudgetDrops(itemTriangles_, itemPixels_, budgetPixels);
-        std::vector<std::uint8_t> droppedParts(truth_.parts.size(), 0);
-        for (std::size_t k = 0; k < wholeParts.size(); ++k) droppedParts[wholeParts[k]] = drops.dropped[truth_.clusters.size() + k];
-        drops.dropped.resize(truth_.clusters.size());
-        oracleRanges(drops.dropped, droppedParts, oracleBudgetRanges_[m]);
-        oracleBudgetPixels_[m] = drops.pixels;
+        for (std::size_t m = 0; m < result_.modes.size(); ++m) {
+            const double percent = result_.modes[m].oracleBudgetPercent;
+            if (percent <= 0.0) continue;
+            BudgetDrops drops = chooseBudgetDrops(itemTriangles_, itemPixels_, errorBudgetPixels(percent, size.x, size.y));
+            std::vector<std::uint8_t> droppedParts(truth_.parts.size(), 0);
+            for (std::size_t k = 0; k < itemWholeParts_.size(); ++k)
+                droppedParts[itemWholeParts_[k]] = drops.dropped[truth_.clusters.size() + k];
+            drops.dropped.resize(truth_.clusters.size());
+            oracleRanges(drops.dropped, droppedParts, oracleBudgetRanges_[m]);
+            oracleBudgetPixels_[m] = drops.pixels;
+        }
     }
 
     std::vector<ModeFrame> row(result_.modes.size());

@@ -179,6 +179,7 @@ private:
     std::vector<std::vector<PartRange>> oracleBudgetRanges_;  // per mode: oracle-budgetP's ranges (empty for other modes)
     std::vector<std::uint64_t> oracleBudgetPixels_;           // per mode: the pixels its ranges leave out this frame
     std::vector<std::uint32_t> itemTriangles_, itemPixels_;   // the budget oracle's items: visible clusters, then clusterless parts
+    std::vector<std::uint32_t> itemWholeParts_;               // the clusterless parts' indices in truth_.parts, in item order
 
     /// oracleParts_' visible clusters (whole parts where they have none) as ranges in `out`,
     /// adjacent ones merged, less those marked dropped (per truth_.clusters, and per

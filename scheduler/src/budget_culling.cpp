@@ -6,15 +6,13 @@
 // so the samples of the parts culled bound the pixels the frame loses. Those samples are
 // spent like a knapsack: greedily, on the parts that save the most drawing per sample.
 #include <algorithm>
-#include <cmath>
 
 #include "cull_frame.hpp"
 
 namespace dyncull {
 
 std::uint64_t QueryScheduler::errorBudgetPixels(const Frame& f) const {
-    const double pixels = double(f.view.width) * double(f.view.height);
-    return static_cast<std::uint64_t>(std::floor(params_.approx.errorBudgetPercent / 100.0 * pixels));
+    return dyncull::errorBudgetPixels(params_.approx.errorBudgetPercent, f.view.width, f.view.height);
 }
 
 void QueryScheduler::spendErrorBudget(Frame& f) {

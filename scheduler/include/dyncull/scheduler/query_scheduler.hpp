@@ -6,6 +6,7 @@
 // Staneker et al., Efficient Multiple Occlusion Queries, sections 3-4.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -152,6 +153,13 @@ struct SchedulerApproximations {
     /// batch and a wait.
     bool budgetRecount = false;
 };
+
+/// An error budget of `percent` of a `width` x `height` viewport, in whole pixels (rounded
+/// down: the budget is never exceeded). The one conversion the scheduler and the
+/// measurements use.
+inline std::uint64_t errorBudgetPixels(double percent, int width, int height) {
+    return static_cast<std::uint64_t>(std::floor(percent / 100.0 * double(width) * double(height)));
+}
 
 /// TwoPhase's cost model: a volume the pyramid cannot reject is tested only where the
 /// test is expected to pay. Its cost is `testNsPerVolume` plus `testNsPerPixel` per
