@@ -101,6 +101,7 @@ bool applyTwoPhaseName(const std::string& part, ModeSpec& m) {
 std::string modeNamesHelp() {
     return "vfc, simple, full (two-phase: draw last frame's visible parts, test the rest against their depth pyramid, then what it cannot reject in one batched raster test where that pays), "
            "queries (hardware occlusion queries with history, batching and occupancy maps; the default before two-phase), oracle (the visible parts, whole), oracle-clusters (only their clusters that own a pixel), "
+           "oracle-boxes (every cluster whose box passes against the final depth: the floor of a cluster-box culler; measures --volume-bound), "
            "oracle-budgetP (oracle-clusters less what an oracle with a budget of P% of the pixels leaves out); "
            "ablations of full: full-hzb (the pyramid alone), full-tri (every part whose volume passes then tested on its own triangles, and draws marked), full-nohist (every part drawn early tested again each frame), full-nocost (every volume the pyramid lets through tested), full-noclusters (parts drawn whole, no cluster tests), full-noclusterhist (early parts drawn with all their clusters, not only those that showed last frame), full-markclusterhist (which clusters showed judged by their fragments' marks when drawn, not by their boxes against the final depth), full-noworker (the deferred clusters tested on the render thread as they are drawn, not ahead of them on a worker); "
            "vfc-noclusters (vfc drawing parts whole); "
@@ -244,6 +245,8 @@ Expected<ModeSpec> modeFromName(const std::string& name) {
     } else if (name == "oracle" || name == "oracle-clusters") {
         m.oracle = true;
         m.oracleClusters = name == "oracle-clusters";
+    } else if (name == "oracle-boxes") {
+        m.oracle = m.oracleBoxes = true;
     } else if (double budget = 0.0; percentAfter(name, "oracle-budget", budget)) {
         if (!(budget > 0.0)) return Error{"--modes: '" + name + "': the budget must be above 0"};
         m.oracle = m.oracleClusters = true;
@@ -374,6 +377,8 @@ Expected<std::unique_ptr<BenchRunner>> BenchRunner::create(Engine& engine, DemoS
     // Visible clusters only where a mode needs them: the ID pass costs twice as much then.
     r->groundTruth_->setClusterIds(std::any_of(modes.begin(), modes.end(), [](const ModeSpec& m) { return m.oracleClusters; }));
     r->groundTruth_->setMeshSubstitute(scene.truthGeometry());
+    r->modesNeedBound_ = std::any_of(modes.begin(), modes.end(), [](const ModeSpec& m) { return m.oracleBoxes; });
+    r->setMeasureVolumeBound(false, r->boundBudgetPercent_);
     BenchResult& res = r->result_;
     res.modes = std::move(modes);
     res.scene = scene.name();
@@ -498,7 +503,8 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
         // The reference image is complete even where the scene may skip work (streamed
         // leaves not yet read), so what a mode skips counts as its error.
         scene_.setReferencePass(m == 0);
-        auto rendered = spec.oracleBudgetPercent > 0 ? engine_.renderPartRanges(oracleBudgetRanges_[m])
+        auto rendered = spec.oracleBoxes              ? engine_.renderPartRanges(boundRanges_)
+                        : spec.oracleBudgetPercent > 0 ? engine_.renderPartRanges(oracleBudgetRanges_[m])
                         : spec.oracleClusters         ? engine_.renderPartRanges(oracleClusterRanges_)
                         : spec.oracle       ? engine_.renderParts(oracleParts_)
                                             : engine_.renderFrame(*schedulers_[m]);
@@ -525,6 +531,7 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
             ft.boundMeasured = true;
             ft.boundAabb = volumeBound(VolumeChoice::Aabb);
             ft.boundAuto = volumeBound(VolumeChoice::Auto);
+            ft.boundClusters = clusterBound();
         }
     }
     auto streamed = scene_.endFrame();
@@ -623,6 +630,126 @@ VolumeBound BenchRunner::volumeBound(VolumeChoice volume) {
     return b;
 }
 
+void BenchRunner::setMeasureVolumeBound(bool on, double budgetPercent) {
+    on = on || modesNeedBound_;
+    measureBound_ = on;
+    boundBudgetPercent_ = budgetPercent;
+    if (on) groundTruth_->setClusterIds(true);  // which passing clusters own no pixel
+}
+
+ClusterBound BenchRunner::clusterBound() {
+    const SceneObjects& objs = engine_.objects();
+    const Camera& cam = engine_.camera();
+    const TwoLevelTree tree(engine_.sceneTree(), objs);
+    QueryBackend& backend = engine_.queryBackend();
+    backend.beginFrame(FrameView::of(cam, result_.width, result_.height));
+    const std::vector<NodeRef>& parts = groundTruth_->lastParts();
+
+    // One box per cluster that does not face away (a part without clusters: its own box),
+    // and for the budget, each clustered part's own box too: dropping a part whole may cost
+    // fewer samples than dropping its clusters one by one.
+    struct Box {
+        PartRange range;        // what it bounds
+        float distance = 0.0f;  // its part's squared distance to the eye
+        std::uint32_t part = 0; // index in `parts`
+        bool hidden = false;    // owns no pixel
+        bool partBox = false;   // a clustered part's own box: a budget item, not drawn
+    };
+    std::vector<Box> boxes;
+    std::vector<QueryVolume> volumes;
+    std::vector<QueryResult> answers;
+    std::vector<std::uint32_t> samples;
+    ClusterBound b;
+    std::vector<std::pair<float, PartRange>> passing;  // (distance, range) of every passing cluster box
+    std::vector<std::uint32_t> itemTriangles, itemSamples;  // the budget's items: passing boxes with known samples
+    std::vector<std::uint64_t> partClusterTriangles(parts.size(), 0);  // of its passing cluster boxes
+    std::vector<std::uint32_t> partSamples(parts.size(), 0);           // of its own passing box
+    auto test = [&] {
+        if (volumes.empty()) return;
+        answers.assign(volumes.size(), QueryResult::Visible);
+        samples.assign(volumes.size(), kUnknownSamples);
+        const BatchId id = backend.testVolumes(volumes, true);
+        if (id != kNoBatch) backend.collectVolumes(id, answers, 60000.0, samples);  // else: all pass, unknown
+        for (std::size_t i = 0; i < volumes.size(); ++i) {
+            if (answers[i] == QueryResult::Occluded) continue;
+            const Box& x = boxes[i];
+            if (x.partBox) {
+                partSamples[x.part] = samples[i];
+                continue;
+            }
+            const std::uint32_t tris = x.range.indexCount / 3;
+            passing.push_back({x.distance, x.range});
+            partClusterTriangles[x.part] += tris;
+            ++b.clusters;
+            b.triangles += tris;
+            if (samples[i] == kUnknownSamples) ++b.unknownSamples;
+            else itemTriangles.push_back(tris), itemSamples.push_back(samples[i]);
+            if (!x.hidden) continue;
+            ++b.hiddenClusters;
+            b.hiddenTriangles += tris;
+            if (samples[i] != kUnknownSamples) b.hiddenSamples += samples[i];
+        }
+        volumes.clear();
+        boxes.clear();
+    };
+    constexpr std::size_t kBatch = 4096;  // bounds the volumes copied per draw
+    for (std::uint32_t p = 0; p < parts.size(); ++p) {
+        const NodeRef r = parts[p];
+        const LocalBsp& model = objs.model(objs.modelOf(r.object));
+        const LocalBspNode& node = model.nodes[r.node];
+        const glm::mat4& toWorld = objs.matrix(r.object);
+        const glm::vec3 d = tree.worldBox(r).center() - cam.position;
+        const float distance = glm::dot(d, d);
+        // The part's clusters that own a pixel (indices into model.clusters), if it is visible.
+        const auto at = std::lower_bound(truth_.parts.begin(), truth_.parts.end(), r);
+        const bool visible = at != truth_.parts.end() && *at == r;
+        std::span<const std::uint32_t> shown;
+        if (visible && !truth_.clusterFirst.empty()) {
+            const std::size_t i = static_cast<std::size_t>(at - truth_.parts.begin());
+            shown = std::span(truth_.clusters).subspan(truth_.clusterFirst[i], truth_.clusterFirst[i + 1] - truth_.clusterFirst[i]);
+        }
+        const bool clustered = model.clusters.builtFor(model.nodes.size()) &&
+                               model.clusters.nodeFirst[r.node] != model.clusters.nodeFirst[r.node + node.subtreeSize];
+        volumes.push_back(QueryVolume::fromTransformedBox(toWorld, node.box));
+        boxes.push_back({{r, node.firstIndex, node.indexCount}, distance, p, !visible, clustered});
+        if (clustered) {
+            // The eye in object space, for the normal cones (as the scheduler's own cone test).
+            const bool cones = model.faces == FaceMode::CullBack;
+            const glm::dmat4 toObject = glm::inverse(glm::dmat4(toWorld));
+            const glm::dvec3 eye(toObject * glm::dvec4(glm::dvec3(cam.position), 1.0));
+            const glm::dvec3 along(toObject * glm::dvec4(glm::dvec3(cam.forward()), 0.0));
+            for (std::uint32_t c = model.clusters.nodeFirst[r.node]; c < model.clusters.nodeFirst[r.node + node.subtreeSize]; ++c) {
+                const LeafCluster& cluster = model.clusters.clusters[c];
+                if (cones && (cam.orthographic() ? cluster.backFacingAlong(along) : cluster.backFacingFrom(eye))) continue;
+                volumes.push_back(QueryVolume::fromTransformedBox(toWorld, cluster.box));
+                boxes.push_back({{r, cluster.firstIndex, cluster.indexCount}, distance, p,
+                                 !std::binary_search(shown.begin(), shown.end(), c), false});
+            }
+        }
+        if (volumes.size() >= kBatch) test();
+    }
+    test();
+    // Front to back by part, as the oracle draws; a part's passing clusters in index order,
+    // adjacent ones merged into one range.
+    std::stable_sort(passing.begin(), passing.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    boundRanges_.clear();
+    for (const auto& [dist, range] : passing) {
+        PartRange* prev = boundRanges_.empty() ? nullptr : &boundRanges_.back();
+        if (prev && prev->part == range.part && prev->firstIndex + prev->indexCount == range.firstIndex)
+            prev->indexCount += range.indexCount;
+        else
+            boundRanges_.push_back(range);
+    }
+    // Any culler's drops are disjoint items of this list (whole parts, or clusters), so the
+    // fractional knapsack over all of them bounds what a budget can leave out.
+    for (std::size_t p = 0; p < parts.size(); ++p)
+        if (partClusterTriangles[p] > 0 && partSamples[p] > 0 && partSamples[p] != kUnknownSamples)
+            itemTriangles.push_back(static_cast<std::uint32_t>(partClusterTriangles[p])), itemSamples.push_back(partSamples[p]);
+    b.budgetPixels = errorBudgetPixels(boundBudgetPercent_, result_.width, result_.height);
+    b.budgetTriangleBound = chooseBudgetDrops(itemTriangles, itemSamples, b.budgetPixels).triangleBound;
+    return b;
+}
+
 void BenchRunner::measureLeafVolumes() {
     result_.leafTotals.assign(result_.modes.size(), {});
     for (std::size_t m = 0; m < result_.modes.size(); ++m) {
@@ -666,7 +793,7 @@ Status runMeasurement(const MeasureOptions& o, std::vector<ModeSpec> modes, cons
 
     auto runner = BenchRunner::create(engine, scene, std::move(modes));
     if (!runner) return Error{runner.error().message};
-    (*runner)->setMeasureVolumeBound(o.volumeBound);
+    (*runner)->setMeasureVolumeBound(o.volumeBound, o.boundBudgetPercent);
     std::string names;
     for (const ModeSpec& m : (*runner)->result().modes) names += (names.empty() ? "" : ",") + m.name;
     std::printf("modes (interleaved per frame, vfc first, the others in rotated order): %s\n", names.c_str());

@@ -36,6 +36,10 @@ struct ModeSpec {
     /// visible clusters an oracle with that error budget leaves out (chooseBudgetDrops):
     /// the floor of any error-budget culler at cluster granularity.
     double oracleBudgetPercent = 0.0;
+    /// oracle-boxes: draws the frame's cluster-box bound (ClusterBound: every cluster whose
+    /// box passes against the final depth), front to back, untested. The floor of any
+    /// conservative culler that tests cluster boxes, measured as time; implies --volume-bound.
+    bool oracleBoxes = false;
     SchedulerParams scheduler;
     GlQueryParams queries;
     /// The family of settings this mode belongs to, one curve in the speed-accuracy plot:
@@ -116,6 +120,29 @@ struct VolumeBound {
     std::uint64_t triangles = 0;
 };
 
+/// The same bound one level down, where parts are drawn as clusters: every cluster of a
+/// part in the frustum that does not face away (its normal cone, where the model culls back
+/// faces) and whose box passes the batched raster test against the frame's final depth
+/// (a part without clusters: its box), with each passing box's samples. What a
+/// conservative culler testing cluster boxes draws at least; and how many of those
+/// triangles an error budget spent on box samples (of clusters, or of whole parts' boxes)
+/// can leave out at most. Measured only with --volume-bound.
+/// The cluster bound's default error budget, % of the frame's pixels: issue 18's target.
+inline constexpr double kDefaultBoundBudgetPercent = 0.1;
+
+struct ClusterBound {
+    std::uint32_t clusters = 0;          ///< boxes that pass (clusters, and parts without clusters)
+    std::uint64_t triangles = 0;         ///< their triangles
+    std::uint32_t hiddenClusters = 0;    ///< of them, those owning no pixel in the ground truth
+    std::uint64_t hiddenTriangles = 0;
+    std::uint64_t hiddenSamples = 0;     ///< those boxes' samples (known counts only)
+    std::uint32_t unknownSamples = 0;    ///< passing boxes whose samples are unknown (near plane)
+    std::uint64_t budgetPixels = 0;      ///< the error budget (--bound-budget of the frame's pixels)
+    /// No choice of clusters and whole parts whose box samples fit in the budget leaves out
+    /// more triangles (the fractional knapsack's optimum over both kinds of item).
+    double budgetTriangleBound = 0.0;
+};
+
 /// Per-frame facts independent of the mode.
 struct FrameTruth {
     std::uint32_t visibleParts = 0;   ///< parts with at least one visible pixel
@@ -128,6 +155,7 @@ struct FrameTruth {
     std::uint64_t visibleClusterTriangles = 0;  ///< triangles of their clusters that own a pixel (what oracle-clusters draws)
     bool boundMeasured = false;          ///< the two bounds below were measured (--volume-bound)
     VolumeBound boundAabb, boundAuto;    ///< with transformed local boxes, and with the auto volumes
+    ClusterBound boundClusters;          ///< with cluster boxes (ClusterBound)
 };
 
 struct BenchResult {
@@ -153,9 +181,12 @@ public:
 
     /// Moves the scene to `frame`, computes the truth and renders every mode; appends to result().
     Status runFrame(std::uint64_t frame);
-    /// Also measure the volume bounds (FrameTruth::boundAabb, boundAuto) each frame:
-    /// two queries per part in the frustum, untimed.
-    void setMeasureVolumeBound(bool on) { measureBound_ = on; }
+    /// Also measure the volume bounds (FrameTruth::boundAabb, boundAuto, boundClusters) each
+    /// frame, untimed: two queries per part in the frustum and a raster test per cluster box.
+    /// The cluster bound's budget is `budgetPercent` of the frame's pixels. Turns on the
+    /// ground truth's cluster ids (which clusters own pixels).
+    /// Always on when a mode is oracle-boxes.
+    void setMeasureVolumeBound(bool on, double budgetPercent = kDefaultBoundBudgetPercent);
     /// Fills result().leafTotals from the scene as it is now (call after the last frame).
     void measureLeafVolumes();
 
@@ -193,6 +224,12 @@ private:
 
     /// Queries the volume of every part in the frustum against the depth buffer as it is.
     VolumeBound volumeBound(VolumeChoice volume);
+    /// Tests every cluster box of every part in the frustum against the depth buffer as it
+    /// is; the passing boxes' ranges, front to back, go to boundRanges_.
+    ClusterBound clusterBound();
+    std::vector<PartRange> boundRanges_;  // oracle-boxes: this frame's cluster-box bound
+    bool modesNeedBound_ = false;         // a mode draws boundRanges_
+    double boundBudgetPercent_ = kDefaultBoundBudgetPercent;
     FalsePositiveCauses falsePositiveCauses() const;
     /// Splits `out.image`'s differing pixels (diffMask_) into lost and tied by the ground
     /// truth's part at each and whether it is among `drawn` (sorted).
@@ -212,6 +249,7 @@ struct MeasureOptions {
     SceneOptions sceneOptions;
     bool quiet = false;  ///< no progress lines on stderr
     bool volumeBound = false;  ///< BenchRunner::setMeasureVolumeBound
+    double boundBudgetPercent = kDefaultBoundBudgetPercent;  ///< the cluster bound's error budget, % of the frame's pixels
 };
 
 /// Creates a headless context and engine, populates the scene, runs `modes` interleaved

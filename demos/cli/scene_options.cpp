@@ -54,7 +54,11 @@ void addMeasureOptions(CLI::App& cmd, MeasureOptions& o, std::string& size, cons
     cmd.add_flag("--quiet", o.quiet, "no progress lines");
     cmd.add_flag("--volume-bound", o.volumeBound,
                  "also query every part's box and auto volume against each frame's final depth (untimed): the parts a "
-                 "conservative query-based mode must draw even with perfect order and no history");
+                 "conservative query-based mode must draw even with perfect order and no history; and every cluster box, with its samples");
+    cmd.add_option("--bound-budget", o.boundBudgetPercent,
+                   "with --volume-bound: the error budget, in % of the frame's pixels, that the cluster bound spends on box "
+                   "samples")
+        ->check(realIn(0.0, 100.0, true))->capture_default_str();
     addBunnyOptions(cmd, o.sceneOptions.bunny);
     addGeneratedSceneOptions(cmd, o.sceneOptions);
 }

@@ -15,6 +15,8 @@ TEST(BenchModes, BaseModes) {
     EXPECT_FALSE(modeFromName("oracle")->oracleClusters);
     EXPECT_TRUE(modeFromName("oracle-clusters")->oracle && modeFromName("oracle-clusters")->oracleClusters);
     EXPECT_EQ(modeFromName("oracle-clusters")->oracleBudgetPercent, 0.0);
+    EXPECT_TRUE(modeFromName("oracle-boxes")->oracle && modeFromName("oracle-boxes")->oracleBoxes);
+    EXPECT_FALSE(modeFromName("oracle-boxes")->oracleClusters);
     const ModeSpec budgetOracle = modeFromName("oracle-budget0.1").take();
     EXPECT_TRUE(budgetOracle.oracle && budgetOracle.oracleClusters);
     EXPECT_DOUBLE_EQ(budgetOracle.oracleBudgetPercent, 0.1);

@@ -97,7 +97,7 @@ protected:
 TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
     ASSERT_NO_FATAL_FAILURE(build("dyncull_conservative_", 30));
 
-    const char* conservative = "vfc,simple,full,full-hzb,full-nohist,full-nocost,full-tri,full-noclusters,full-noclusterhist,full-markclusterhist,full-noworker,queries,queries-nohist,queries-nobatch,queries-noocc,queries-notight,queries-nodrawq,order,front10,oracle,oracle-clusters,thr64";
+    const char* conservative = "vfc,simple,full,full-hzb,full-nohist,full-nocost,full-tri,full-noclusters,full-noclusterhist,full-markclusterhist,full-noworker,queries,queries-nohist,queries-nobatch,queries-noocc,queries-notight,queries-nodrawq,order,front10,oracle,oracle-clusters,oracle-boxes,thr64";
     auto modes = cli::modesFromList(conservative);
     ASSERT_TRUE(modes.ok()) << modes.error().message;
     // The test checks culling, not latency: a query that outlasts the default 250 ms bound
@@ -113,6 +113,8 @@ TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
     std::uint64_t visibleSeen = 0, thresholdMisses = 0, occludedSeen = 0, queries = 0, drawQueriesOccluded = 0, boundSlack = 0;
     std::uint64_t rasterTests = 0, rasterParts = 0, pyramidParts = 0;  // full with and without the batched raster test
     std::uint64_t clusterTriangles = 0, partTriangles = 0;  // the visible clusters' and parts' triangles
+    std::uint64_t clusterBoundHidden = 0;  // cluster boxes that pass with no pixel of their own
+    double budgetReach = 0.0;              // triangles the cluster bound's budget could leave out
     double worstPercent = 0.0;
     for (std::uint64_t frame = 0; frame < bo.frames; ++frame) {
         ASSERT_TRUE((*runner)->runFrame(frame).ok());
@@ -129,9 +131,20 @@ TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
             EXPECT_GE(b.triangles, truth.visibleTriangles);
         }
         boundSlack += truth.boundAabb.parts - truth.visibleParts;
+        // Every visible cluster faces the eye and its box passes: the cluster bound is the
+        // visible clusters and the hidden ones whose boxes show; the budget lies inside it.
+        const cli::ClusterBound& cb = truth.boundClusters;
+        EXPECT_EQ(cb.triangles, truth.visibleClusterTriangles + cb.hiddenTriangles);
+        EXPECT_EQ(cb.budgetPixels, 57u);  // 0.1% of 320 x 180, rounded down
+        EXPECT_LE(cb.budgetTriangleBound, static_cast<double>(cb.triangles));
+        clusterBoundHidden += cb.hiddenClusters;
+        budgetReach += cb.budgetTriangleBound;
         for (std::size_t m = 0; m < row.size(); ++m) {
-            if (names[m].oracle) {
+            if (names[m].oracle && !names[m].oracleBoxes) {
                 EXPECT_EQ(row[m].parts.falsePositives, 0u);  // exactly the visible set
+            }
+            if (names[m].oracleBoxes) {
+                EXPECT_EQ(row[m].stats.trianglesDrawn, cb.triangles);  // the bound, drawn
             }
             if (names[m].oracleClusters) {
                 // Only the clusters owning a pixel, and still the whole picture (checked below).
@@ -153,9 +166,11 @@ TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
                 pyramidParts += row[m].stats.partsDrawn;
                 EXPECT_EQ(row[m].stats.rasterTests, 0u);
             }
-            // Every false positive has exactly one cause.
+            // Every false positive of a scheduler has exactly one cause.
             const cli::FalsePositiveCauses& c = row[m].falsePositiveCauses;
-            EXPECT_EQ(c.queried + c.history + c.occupancy + c.other, row[m].parts.falsePositives);
+            if (!names[m].oracle) {
+                EXPECT_EQ(c.queried + c.history + c.occupancy + c.other, row[m].parts.falsePositives);
+            }
             EXPECT_LE(row[m].image.percentDiffering, 0.01);
             EXPECT_EQ(row[m].parts.falseNegatives, 0u);
             EXPECT_EQ(row[m].stats.queriesTimedOut, 0u);
@@ -174,6 +189,8 @@ TEST_F(ConservativeSwarm, EveryConservativeModeDrawsTheVfcImage) {
     // Real GL draw queries answered, and some parts drawn untested turned out hidden.
     EXPECT_GT(drawQueriesOccluded, 0u);
     EXPECT_GT(boundSlack, 0u) << "some hidden part should have a visible box";
+    EXPECT_GT(clusterBoundHidden, 0u) << "some hidden cluster should have a visible box";
+    EXPECT_GT(budgetReach, 0.0);
     // The batched raster test ran, and culled parts the pyramid alone let through.
     EXPECT_GT(rasterTests, 0u);
     EXPECT_LT(rasterParts, pyramidParts);
