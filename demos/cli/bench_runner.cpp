@@ -2,6 +2,7 @@
 #include "bench_runner.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <charconv>
 #include <cstdio>
 #include <filesystem>
@@ -645,75 +646,47 @@ ClusterBound BenchRunner::clusterBound() {
     backend.beginFrame(FrameView::of(cam, result_.width, result_.height));
     const std::vector<NodeRef>& parts = groundTruth_->lastParts();
 
-    // One box per cluster that does not face away (a part without clusters: its own box),
-    // and for the budget, each clustered part's own box too: dropping a part whole may cost
-    // fewer samples than dropping its clusters one by one.
+    // Each part's own volumes (its box, PCA box and 26-DOP: a culler may test any of them,
+    // so the part shows only if all pass, with the fewest samples of the three), and the
+    // boxes of its clusters that do not face away.
     struct Box {
-        PartRange range;        // what it bounds
-        float distance = 0.0f;  // its part's squared distance to the eye
-        std::uint32_t part = 0; // index in `parts`
-        bool hidden = false;    // owns no pixel
-        bool partBox = false;   // a clustered part's own box: a budget item, not drawn
+        std::uint32_t part = 0;  // index in `parts`
+        std::uint32_t cluster = kInvalidIndex;  // into its model's clusters; kInvalidIndex: a part volume
     };
     std::vector<Box> boxes;
-    std::vector<QueryVolume> volumes;
+    std::vector<std::uint32_t> boxSamples;  // per box: 0 if it did not pass, else its samples (or kUnknownSamples)
+    std::vector<QueryVolume> volumes;       // the batch being built: boxes [tested, tested + size)
     std::vector<QueryResult> answers;
     std::vector<std::uint32_t> samples;
-    ClusterBound b;
-    std::vector<std::pair<float, PartRange>> passing;  // (distance, range) of every passing cluster box
-    std::vector<std::uint32_t> itemTriangles, itemSamples;  // the budget's items: passing boxes with known samples
-    std::vector<std::uint64_t> partClusterTriangles(parts.size(), 0);  // of its passing cluster boxes
-    std::vector<std::uint32_t> partSamples(parts.size(), 0);           // of its own passing box
     auto test = [&] {
         if (volumes.empty()) return;
         answers.assign(volumes.size(), QueryResult::Visible);
         samples.assign(volumes.size(), kUnknownSamples);
         const BatchId id = backend.testVolumes(volumes, true);
         if (id != kNoBatch) backend.collectVolumes(id, answers, 60000.0, samples);  // else: all pass, unknown
-        for (std::size_t i = 0; i < volumes.size(); ++i) {
-            if (answers[i] == QueryResult::Occluded) continue;
-            const Box& x = boxes[i];
-            if (x.partBox) {
-                partSamples[x.part] = samples[i];
-                continue;
-            }
-            const std::uint32_t tris = x.range.indexCount / 3;
-            passing.push_back({x.distance, x.range});
-            partClusterTriangles[x.part] += tris;
-            ++b.clusters;
-            b.triangles += tris;
-            if (samples[i] == kUnknownSamples) ++b.unknownSamples;
-            else itemTriangles.push_back(tris), itemSamples.push_back(samples[i]);
-            if (!x.hidden) continue;
-            ++b.hiddenClusters;
-            b.hiddenTriangles += tris;
-            if (samples[i] != kUnknownSamples) b.hiddenSamples += samples[i];
-        }
+        for (std::size_t i = 0; i < volumes.size(); ++i)
+            boxSamples.push_back(answers[i] == QueryResult::Occluded ? 0u : samples[i]);
         volumes.clear();
-        boxes.clear();
+    };
+    // A part drawn as its clusters: its model has them, and it has some (a hand-built
+    // tree's leaves may have none).
+    auto clustered = [&](const LocalBsp& model, NodeRef r) {
+        return model.clusters.builtFor(model.nodes.size()) &&
+               model.clusters.nodeFirst[r.node] != model.clusters.nodeFirst[r.node + model.nodes[r.node].subtreeSize];
     };
     constexpr std::size_t kBatch = 4096;  // bounds the volumes copied per draw
+    const float autoSaving = SchedulerParams{}.tuning.autoVolumeSaving;
     for (std::uint32_t p = 0; p < parts.size(); ++p) {
         const NodeRef r = parts[p];
         const LocalBsp& model = objs.model(objs.modelOf(r.object));
         const LocalBspNode& node = model.nodes[r.node];
-        const glm::mat4& toWorld = objs.matrix(r.object);
-        const glm::vec3 d = tree.worldBox(r).center() - cam.position;
-        const float distance = glm::dot(d, d);
-        // The part's clusters that own a pixel (indices into model.clusters), if it is visible.
-        const auto at = std::lower_bound(truth_.parts.begin(), truth_.parts.end(), r);
-        const bool visible = at != truth_.parts.end() && *at == r;
-        std::span<const std::uint32_t> shown;
-        if (visible && !truth_.clusterFirst.empty()) {
-            const std::size_t i = static_cast<std::size_t>(at - truth_.parts.begin());
-            shown = std::span(truth_.clusters).subspan(truth_.clusterFirst[i], truth_.clusterFirst[i + 1] - truth_.clusterFirst[i]);
+        for (const VolumeChoice v : {VolumeChoice::Aabb, VolumeChoice::Obb, VolumeChoice::Kdop26}) {
+            volumes.push_back(objectNodeVolume(objs, r, v, autoSaving));
+            boxes.push_back({p, kInvalidIndex});
         }
-        const bool clustered = model.clusters.builtFor(model.nodes.size()) &&
-                               model.clusters.nodeFirst[r.node] != model.clusters.nodeFirst[r.node + node.subtreeSize];
-        volumes.push_back(QueryVolume::fromTransformedBox(toWorld, node.box));
-        boxes.push_back({{r, node.firstIndex, node.indexCount}, distance, p, !visible, clustered});
-        if (clustered) {
+        if (clustered(model, r)) {
             // The eye in object space, for the normal cones (as the scheduler's own cone test).
+            const glm::mat4& toWorld = objs.matrix(r.object);
             const bool cones = model.faces == FaceMode::CullBack;
             const glm::dmat4 toObject = glm::inverse(glm::dmat4(toWorld));
             const glm::dvec3 eye(toObject * glm::dvec4(glm::dvec3(cam.position), 1.0));
@@ -722,13 +695,66 @@ ClusterBound BenchRunner::clusterBound() {
                 const LeafCluster& cluster = model.clusters.clusters[c];
                 if (cones && (cam.orthographic() ? cluster.backFacingAlong(along) : cluster.backFacingFrom(eye))) continue;
                 volumes.push_back(QueryVolume::fromTransformedBox(toWorld, cluster.box));
-                boxes.push_back({{r, cluster.firstIndex, cluster.indexCount}, distance, p,
-                                 !std::binary_search(shown.begin(), shown.end(), c), false});
+                boxes.push_back({p, c});
             }
         }
         if (volumes.size() >= kBatch) test();
     }
     test();
+    assert(boxSamples.size() == boxes.size());
+
+    // A part's volumes come first, then its clusters, so one pass in order decides both.
+    ClusterBound b;
+    std::vector<std::pair<float, PartRange>> passing;  // (part's squared distance, range) of every passing item
+    std::vector<std::uint32_t> itemTriangles, itemSamples;  // the budget's items with known samples
+    for (std::size_t i = 0; i < boxes.size();) {
+        const std::uint32_t p = boxes[i].part;
+        const NodeRef r = parts[p];
+        const LocalBsp& model = objs.model(objs.modelOf(r.object));
+        const LocalBspNode& node = model.nodes[r.node];
+        std::uint32_t partSamples = kUnknownSamples;
+        for (; i < boxes.size() && boxes[i].part == p && boxes[i].cluster == kInvalidIndex; ++i)
+            partSamples = std::min(partSamples, boxSamples[i]);
+        const std::size_t clustersBegin = i;
+        while (i < boxes.size() && boxes[i].part == p) ++i;
+        if (partSamples == 0) continue;  // one of its volumes is hidden: the part is
+        const glm::vec3 d = tree.worldBox(r).center() - cam.position;
+        const float distance = glm::dot(d, d);
+        // The part's clusters that own a pixel (indices into model.clusters), if it is visible.
+        const auto at = std::lower_bound(truth_.parts.begin(), truth_.parts.end(), r);
+        const bool visible = at != truth_.parts.end() && *at == r;
+        std::span<const std::uint32_t> shown;
+        if (visible && !truth_.clusterFirst.empty()) {
+            const std::size_t k = static_cast<std::size_t>(at - truth_.parts.begin());
+            shown = std::span(truth_.clusters).subspan(truth_.clusterFirst[k], truth_.clusterFirst[k + 1] - truth_.clusterFirst[k]);
+        }
+        auto pass = [&](std::uint32_t firstIndex, std::uint32_t indexCount, std::uint32_t boxSamplesOf, bool hidden) {
+            const std::uint32_t tris = indexCount / 3;
+            passing.push_back({distance, PartRange{r, firstIndex, indexCount}});
+            ++b.clusters;
+            b.triangles += tris;
+            if (boxSamplesOf == kUnknownSamples) ++b.unknownSamples;
+            else itemTriangles.push_back(tris), itemSamples.push_back(boxSamplesOf);
+            if (!hidden) return;
+            ++b.hiddenClusters;
+            b.hiddenTriangles += tris;
+            if (boxSamplesOf != kUnknownSamples) b.hiddenSamples += boxSamplesOf;
+        };
+        std::uint64_t partTriangles = 0;  // of its passing items
+        if (!clustered(model, r)) {
+            pass(node.firstIndex, node.indexCount, partSamples, !visible);
+            continue;  // the part is the item
+        }
+        for (std::size_t j = clustersBegin; j < i; ++j) {
+            if (boxSamples[j] == 0) continue;
+            const LeafCluster& cluster = model.clusters.clusters[boxes[j].cluster];
+            pass(cluster.firstIndex, cluster.indexCount, boxSamples[j], !std::binary_search(shown.begin(), shown.end(), boxes[j].cluster));
+            partTriangles += cluster.indexCount / 3;
+        }
+        // Left out whole, for its volumes' samples: possibly fewer than its clusters' sum.
+        if (partTriangles > 0 && partSamples != kUnknownSamples)
+            itemTriangles.push_back(static_cast<std::uint32_t>(partTriangles)), itemSamples.push_back(partSamples);
+    }
     // Front to back by part, as the oracle draws; a part's passing clusters in index order,
     // adjacent ones merged into one range.
     std::stable_sort(passing.begin(), passing.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
@@ -742,9 +768,6 @@ ClusterBound BenchRunner::clusterBound() {
     }
     // Any culler's drops are disjoint items of this list (whole parts, or clusters), so the
     // fractional knapsack over all of them bounds what a budget can leave out.
-    for (std::size_t p = 0; p < parts.size(); ++p)
-        if (partClusterTriangles[p] > 0 && partSamples[p] > 0 && partSamples[p] != kUnknownSamples)
-            itemTriangles.push_back(static_cast<std::uint32_t>(partClusterTriangles[p])), itemSamples.push_back(partSamples[p]);
     b.budgetPixels = errorBudgetPixels(boundBudgetPercent_, result_.width, result_.height);
     b.budgetTriangleBound = chooseBudgetDrops(itemTriangles, itemSamples, b.budgetPixels).triangleBound;
     return b;

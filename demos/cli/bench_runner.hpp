@@ -120,10 +120,11 @@ struct VolumeBound {
     std::uint64_t triangles = 0;
 };
 
-/// The same bound one level down, where parts are drawn as clusters: every cluster of a
-/// part in the frustum that does not face away (its normal cone, where the model culls back
-/// faces) and whose box passes the batched raster test against the frame's final depth
-/// (a part without clusters: its box), with each passing box's samples. What a
+/// The same bound one level down, where parts are drawn as clusters: every cluster that
+/// does not face away (its normal cone, where the model culls back faces) and whose box
+/// passes the batched raster test against the frame's final depth, of every part in the
+/// frustum whose box, PCA box and 26-DOP all pass too (a part without clusters: the part),
+/// with each passing box's samples. What a
 /// conservative culler testing cluster boxes draws at least; and how many of those
 /// triangles an error budget spent on box samples (of clusters, or of whole parts' boxes)
 /// can leave out at most. Measured only with --volume-bound.

@@ -499,8 +499,9 @@ void writeFalsePositiveTable(std::ostream& f, const BenchResult& r, const std::v
       << fmt(visibleTris > 0 ? aabbTris / visibleTris : 0.0, 3) << " |\n"
       << "| auto (k-DOPs where they pay) | " << fmt(autoParts / n, 1) << " | " << fmt(autoTris / n, 0) << " | "
       << fmt(visibleTris > 0 ? autoTris / visibleTris : 0.0, 3) << " |\n"
-      << "\n**Cluster-box bound**: every cluster of a part in the frustum that does not face away and whose box "
-      << "passes the batched raster test against the final depth (parts without clusters: their box). Per frame: "
+      << "\n**Cluster-box bound**: every cluster that does not face away and whose box passes the batched raster "
+      << "test against the final depth, of the parts whose box, PCA box and 26-DOP all pass too (parts without "
+      << "clusters: the part). Per frame: "
       << fmt(clusterTris / n, 0) << " triangles (the visible clusters hold " << fmt(visibleClusterTris / n, 0)
       << "); of them " << fmt(hiddenClusters / n, 1) << " boxes own no pixel, with " << fmt(hiddenTris / n, 0)
       << " triangles and " << fmt(hiddenSamples / n, 0) << " box samples. An error budget of "
