@@ -643,12 +643,14 @@ ClusterBound BenchRunner::clusterBound() {
     const Camera& cam = engine_.camera();
     const TwoLevelTree tree(engine_.sceneTree(), objs);
     QueryBackend& backend = engine_.queryBackend();
-    backend.beginFrame(FrameView::of(cam, result_.width, result_.height));
+    const FrameView view = FrameView::of(cam, result_.width, result_.height);
+    backend.beginFrame(view);
     const std::vector<NodeRef>& parts = groundTruth_->lastParts();
 
     // Each part's own volumes (its box, PCA box and 26-DOP: a culler may test any of them,
     // so the part shows only if all pass, with the fewest samples of the three), and the
-    // boxes of its clusters that do not face away.
+    // boxes of its clusters that do not face away and are not outside the frustum (a box
+    // behind the eye would reach the near plane and pass).
     struct Box {
         std::uint32_t part = 0;  // index in `parts`
         std::uint32_t cluster = kInvalidIndex;  // into its model's clusters; kInvalidIndex: a part volume
@@ -694,6 +696,7 @@ ClusterBound BenchRunner::clusterBound() {
             for (std::uint32_t c = model.clusters.nodeFirst[r.node]; c < model.clusters.nodeFirst[r.node + node.subtreeSize]; ++c) {
                 const LeafCluster& cluster = model.clusters.clusters[c];
                 if (cones && (cam.orthographic() ? cluster.backFacingAlong(along) : cluster.backFacingFrom(eye))) continue;
+                if (view.frustum.outside(transformAabb(toWorld, cluster.box))) continue;
                 volumes.push_back(QueryVolume::fromTransformedBox(toWorld, cluster.box));
                 boxes.push_back({p, c});
             }

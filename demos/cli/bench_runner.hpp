@@ -121,7 +121,8 @@ struct VolumeBound {
 };
 
 /// The same bound one level down, where parts are drawn as clusters: every cluster that
-/// does not face away (its normal cone, where the model culls back faces) and whose box
+/// does not face away (its normal cone, where the model culls back faces), is not outside
+/// the frustum and whose box
 /// passes the batched raster test against the frame's final depth, of every part in the
 /// frustum whose box, PCA box and 26-DOP all pass too (a part without clusters: the part),
 /// with each passing box's samples. What a
