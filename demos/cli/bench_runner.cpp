@@ -300,7 +300,8 @@ Expected<std::vector<ModeSpec>> modesFromList(const std::string& list) {
 
 std::string sweepParamsHelp() {
     return "pixel-threshold, max-skip, skip-per-visible, small-feature, max-in-flight, tile-size, auto-saving (percent), "
-           "latency (0 or 1 frames); error-budget (full; percent of the frame's pixels, decimals allowed)";
+           "latency (0 or 1 frames); error-budget (full; percent of the frame's pixels, decimals allowed); pyramid-span (full; "
+           "texels a side of the late pass's pyramid tests, 2 to 64)";
 }
 
 Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec) {
@@ -335,6 +336,9 @@ Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec) {
             m.scheduler.tuning.maxQueriesInFlight = v;
         } else if (param == "tile-size") {
             m.scheduler.tuning.occupancyTileSize = static_cast<int>(std::min<std::uint32_t>(v, 1u << 20));
+        } else if (param == "pyramid-span") {
+            m.scheduler.mode = CullMode::TwoPhase;
+            m.scheduler.tuning.pyramidSpan = static_cast<int>(std::min<std::uint32_t>(v, 1u << 20));
         } else if (param == "auto-saving") {
             m.scheduler.tuning.volume = VolumeChoice::Auto;
             m.scheduler.tuning.autoVolumeSaving = static_cast<float>(v) / 100.0f;

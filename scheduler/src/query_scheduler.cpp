@@ -66,6 +66,7 @@ Status validateSchedulerParams(const SchedulerParams& p) {
     if (!(p.approx.errorBudgetPercent >= 0.0 && p.approx.errorBudgetPercent <= 100.0))
         return Error{"errorBudgetPercent must be in [0, 100] (percent of the frame's pixels)"};
     if (p.tuning.costs.probeFrames == 0) return Error{"costs.probeFrames must be at least 1"};
+    if (p.tuning.pyramidSpan < 2 || p.tuning.pyramidSpan > 64) return Error{"pyramidSpan must be in [2, 64] (texels)"};
     return {};
 }
 

@@ -182,7 +182,7 @@ void QueryScheduler::lateTraversal(Frame& f, bool testing, bool haveDepth, bool 
             ++f.stats.depthTests;
             // The pyramid exists only for a single-sample target, where a volume that covers
             // no pixel centre draws nothing.
-            if (fp.centres.empty() || pyramid_.occluded(fp.centres, fp.nearest)) {
+            if (fp.centres.empty() || pyramid_.occluded(fp.centres, fp.nearest, params_.tuning.pyramidSpan)) {
                 ++f.stats.queriesOccluded;
                 culledTriangles_ += subtreeTriangles(f, ref);
                 history_.recordAnswer(h, false, f.index);

@@ -74,7 +74,7 @@ TEST(DepthPyramid, NeverNearerThanTheExactFarthestAndExactForSmallRects) {
                 EXPECT_FALSE(p.occluded(r, std::nextafter(truth, 2.0f)));
                 // A wider span reads a finer level: never nearer than the exact answer either,
                 // and exact for rectangles up to that span.
-                for (const int span : {2, 16}) {
+                for (const int span : {2, 16, 64}) {
                     EXPECT_FALSE(p.occluded(r, truth, span)) << "span " << span;
                     if (r.x1 - r.x0 <= span && r.y1 - r.y0 <= span && truth > 0.0f) {
                         EXPECT_TRUE(p.occluded(r, truth * (1.0f - 2.0f * DepthPyramid::kDepthSlack), span))

@@ -379,6 +379,13 @@ TEST(QueryScheduler, ParamsAreValidated) {
     p = {};
     p.tuning.occupancyTileSize = 0;
     EXPECT_FALSE(validateSchedulerParams(p).ok());
+    for (const int span : {0, 1, 65}) {
+        p = {};
+        p.tuning.pyramidSpan = span;
+        EXPECT_FALSE(validateSchedulerParams(p).ok()) << span;
+    }
+    p.tuning.pyramidSpan = 64;
+    EXPECT_TRUE(validateSchedulerParams(p).ok());
     EXPECT_FALSE(parseCullMode("fast").ok());
     EXPECT_EQ(parseCullMode("full").value(), CullMode::TwoPhase);
     EXPECT_EQ(parseCullMode("queries").value(), CullMode::Queries);

@@ -229,6 +229,13 @@ struct SchedulerTuning {
     /// 4, which uses about 5% for CAD and 10-15% for architecture). Costs one hierarchical
     /// frustum count per frame; conservative (it only adds draws). 0 = off, at most 100.
     float frontPercent = 0.0f;
+    /// TwoPhase: the late pass tests a part's volume at the finest pyramid level where its
+    /// screen rectangle spans at most this many texels a side (DepthPyramid::occluded; at
+    /// most pyramidSpan^2 reads, in [2, 64]). Finer rejects more parts before the batched
+    /// raster test, at 5 us a volume, has to: 16 tested a quarter fewer volumes than 4 on the
+    /// bunny path and was faster on every bundled scene; 32 gained nothing more
+    /// (docs/BENCHMARKS.md, "pyramid span").
+    int pyramidSpan = 16;
     TestCosts costs;
 };
 
