@@ -70,6 +70,8 @@ int main(int argc, char** argv) {
     CLI::App app{"Cost of the batched raster test and of hardware queries per volume (640x360)"};
     int rounds = 9;
     app.add_option("--rounds", rounds, "timed rounds per case (median reported)")->check(CLI::Range(1, 1000))->capture_default_str();
+    bool noRing = false;
+    app.add_flag("--no-ring", noRing, "draw the volumes without their snapping ring (GlQueryParams::snappingRing), to measure what it costs");
     CLI11_PARSE(app, argc, argv);
 
     ContextOptions options;
@@ -81,7 +83,9 @@ int main(int argc, char** argv) {
         return 1;
     }
     auto renderer = Renderer::create(**ctx);
-    auto backend = GlQueryBackend::create(**ctx);
+    GlQueryParams queryParams;
+    queryParams.snappingRing = !noRing;
+    auto backend = GlQueryBackend::create(**ctx, queryParams);
     if (!renderer || !backend) {
         std::fprintf(stderr, "bench_volume_tests: %s\n", (!renderer ? renderer.error() : backend.error()).message.c_str());
         return 1;
