@@ -396,6 +396,18 @@ Expected<std::unique_ptr<BenchRunner>> BenchRunner::create(Engine& engine, DemoS
     return r;
 }
 
+namespace {
+/// Appends `r` to `out`, merged into the last range if that is the same part's and ends
+/// where `r` starts: the oracles draw each run of adjacent clusters as one range.
+void appendRange(std::vector<PartRange>& out, const PartRange& r) {
+    PartRange* prev = out.empty() ? nullptr : &out.back();
+    if (prev && prev->part == r.part && prev->firstIndex + prev->indexCount == r.firstIndex)
+        prev->indexCount += r.indexCount;
+    else
+        out.push_back(r);
+}
+}  // namespace
+
 void BenchRunner::oracleRanges(std::span<const std::uint8_t> droppedClusters, std::span<const std::uint8_t> droppedParts,
                                std::vector<PartRange>& out) const {
     out.clear();
@@ -411,15 +423,10 @@ void BenchRunner::oracleRanges(std::span<const std::uint8_t> droppedClusters, st
             out.push_back({ref, n.firstIndex, n.indexCount});
             continue;
         }
-        const std::size_t start = out.size();
         for (std::size_t c = first; c < last; ++c) {
             if (!droppedClusters.empty() && droppedClusters[c]) continue;
             const LeafCluster& cl = model.clusters.clusters[truth_.clusters[c]];
-            PartRange* prev = out.size() > start ? &out.back() : nullptr;
-            if (prev && prev->firstIndex + prev->indexCount == cl.firstIndex)
-                prev->indexCount += cl.indexCount;
-            else
-                out.push_back({ref, cl.firstIndex, cl.indexCount});
+            appendRange(out, {ref, cl.firstIndex, cl.indexCount});
         }
     }
 }
@@ -691,15 +698,12 @@ ClusterBound BenchRunner::clusterBound() {
             boxes.push_back({p, kInvalidIndex});
         }
         if (clustered(model, r)) {
-            // The eye in object space, for the normal cones (as the scheduler's own cone test).
             const glm::mat4& toWorld = objs.matrix(r.object);
             const bool cones = model.faces == FaceMode::CullBack;
-            const glm::dmat4 toObject = glm::inverse(glm::dmat4(toWorld));
-            const glm::dvec3 eye(toObject * glm::dvec4(glm::dvec3(cam.position), 1.0));
-            const glm::dvec3 along(toObject * glm::dvec4(glm::dvec3(cam.forward()), 0.0));
+            const ObjectSpaceEye eye(cam, toWorld);
             for (std::uint32_t c = model.clusters.nodeFirst[r.node]; c < model.clusters.nodeFirst[r.node + node.subtreeSize]; ++c) {
                 const LeafCluster& cluster = model.clusters.clusters[c];
-                if (cones && (cam.orthographic() ? cluster.backFacingAlong(along) : cluster.backFacingFrom(eye))) continue;
+                if (cones && eye.backFacing(cluster)) continue;
                 if (view.frustum.outside(transformAabb(toWorld, cluster.box))) continue;
                 volumes.push_back(QueryVolume::fromTransformedBox(toWorld, cluster.box));
                 boxes.push_back({p, c});
@@ -766,13 +770,7 @@ ClusterBound BenchRunner::clusterBound() {
     // adjacent ones merged into one range.
     std::stable_sort(passing.begin(), passing.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
     boundRanges_.clear();
-    for (const auto& [dist, range] : passing) {
-        PartRange* prev = boundRanges_.empty() ? nullptr : &boundRanges_.back();
-        if (prev && prev->part == range.part && prev->firstIndex + prev->indexCount == range.firstIndex)
-            prev->indexCount += range.indexCount;
-        else
-            boundRanges_.push_back(range);
-    }
+    for (const auto& [dist, range] : passing) appendRange(boundRanges_, range);
     // Any culler's drops are disjoint items of this list (whole parts, or clusters), so the
     // fractional knapsack over all of them bounds what a budget can leave out.
     b.budgetPixels = errorBudgetPixels(boundBudgetPercent_, result_.width, result_.height);

@@ -17,23 +17,6 @@ inline double msSince(SchedulerClock::time_point t0) {
     return std::chrono::duration<double, std::milli>(SchedulerClock::now() - t0).count();
 }
 
-/// The eye as an object sees it, for the clusters' normal-cone test: in the object's space,
-/// in double (affine maps keep which side of a plane a point is on, mirroring included, as
-/// the rasteriser's facing follows the transformed winding).
-struct ObjectSpaceEye {
-    ObjectSpaceEye() = default;
-    ObjectSpaceEye(const Camera& camera, const glm::mat4& objectToWorld) : ortho(camera.orthographic()) {
-        const glm::dmat4 toObject = glm::inverse(glm::dmat4(objectToWorld));
-        eye = glm::dvec3(toObject * glm::dvec4(glm::dvec3(camera.position), 1.0));
-        along = glm::dvec3(toObject * glm::dvec4(glm::dvec3(camera.forward()), 0.0));
-    }
-    /// True only if every triangle of `c` faces away from the eye (LeafCluster::backFacingFrom).
-    bool backFacing(const LeafCluster& c) const { return ortho ? c.backFacingAlong(along) : c.backFacingFrom(eye); }
-
-    bool ortho = false;
-    glm::dvec3 eye{0.0}, along{0.0};  ///< the eye point, and the view direction (orthographic)
-};
-
 struct QueryScheduler::Frame {
     const TwoLevelTree& tree;
     const SceneObjects& objects;  ///< tree.objects()

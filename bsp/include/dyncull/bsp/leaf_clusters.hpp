@@ -20,6 +20,7 @@
 #include <glm/glm.hpp>
 
 #include "dyncull/objects/aabb.hpp"
+#include "dyncull/objects/camera.hpp"
 #include "dyncull/objects/mesh.hpp"
 
 namespace dyncull {
@@ -57,6 +58,24 @@ struct LeafCluster {
     bool backFacingAlong(const glm::dvec3& direction) const;
     /// Margin on the cone's cosine: about 0.06 degrees.
     static constexpr double kConeMargin = 0x1p-10;
+};
+
+/// The eye as an object sees it, for the clusters' normal-cone test: the world-space
+/// camera taken into the space of an object with the affine `objectToWorld`, in double
+/// (affine maps keep which side of a plane a point is on, mirroring included, as the
+/// rasteriser's facing follows the transformed winding). Holds values only.
+struct ObjectSpaceEye {
+    ObjectSpaceEye() = default;
+    ObjectSpaceEye(const Camera& camera, const glm::mat4& objectToWorld) : ortho(camera.orthographic()) {
+        const glm::dmat4 toObject = glm::inverse(glm::dmat4(objectToWorld));
+        eye = glm::dvec3(toObject * glm::dvec4(glm::dvec3(camera.position), 1.0));
+        along = glm::dvec3(toObject * glm::dvec4(glm::dvec3(camera.forward()), 0.0));
+    }
+    /// True only if every triangle of `c` faces away from the eye (LeafCluster::backFacingFrom).
+    bool backFacing(const LeafCluster& c) const { return ortho ? c.backFacingAlong(along) : c.backFacingFrom(eye); }
+
+    bool ortho = false;
+    glm::dvec3 eye{0.0}, along{0.0};  ///< the eye point, and the view direction (orthographic)
 };
 
 /// Every leaf's clusters, in leaf order, and per node where they start: node i's subtree
