@@ -70,8 +70,12 @@ int main(int argc, char** argv) {
     CLI::App app{"Cost of the batched raster test and of hardware queries per volume (640x360)"};
     int rounds = 9;
     app.add_option("--rounds", rounds, "timed rounds per case (median reported)")->check(CLI::Range(1, 1000))->capture_default_str();
-    bool noRing = false;
-    app.add_flag("--no-ring", noRing, "draw the volumes without their snapping ring (GlQueryParams::snappingRing), to measure what it costs");
+    std::string margin = "grow";
+    app.add_option("--margin", margin,
+                   "the snapping margin (GlQueryParams::snapping): grow (boxes grown across the view), ring (a strip along every "
+                   "outline), none (not conservative: to measure what the margin costs)")
+        ->check(CLI::IsMember({"grow", "ring", "none"}))
+        ->capture_default_str();
     CLI11_PARSE(app, argc, argv);
 
     ContextOptions options;
@@ -84,7 +88,7 @@ int main(int argc, char** argv) {
     }
     auto renderer = Renderer::create(**ctx);
     GlQueryParams queryParams;
-    queryParams.snappingRing = !noRing;
+    queryParams.snapping = margin == "ring" ? SnappingMargin::Ring : margin == "none" ? SnappingMargin::None : SnappingMargin::GrowBoxes;
     auto backend = GlQueryBackend::create(**ctx, queryParams);
     if (!renderer || !backend) {
         std::fprintf(stderr, "bench_volume_tests: %s\n", (!renderer ? renderer.error() : backend.error()).message.c_str());

@@ -95,17 +95,8 @@ GlQueryBackend::~GlQueryBackend() {
 
 void GlQueryBackend::beginFrame(const FrameView& frame) {
     // Camera-relative like the renderer: volumes are uploaded relative to the eye.
-    const Camera& camera = frame.camera;
     viewProj_ = glm::mat4(frame.viewProjRelative);
-    detail::VolumeView& v = *view_;
-    v.eye = glm::dvec3(camera.position);
-    v.forward = glm::dvec3(camera.forward());
-    v.nearPlane = double(camera.nearPlane);
-    v.viewProj = frame.viewProjRelative;
-    v.inverseViewProj = frame.inverseViewProjRelative;
-    v.width = frame.width;
-    v.height = frame.height;
-    v.ringPixels = params_.snappingRing ? detail::ringWidth(subpixelBits_) : 0.0;
+    *view_ = detail::VolumeView::of(frame, params_.snapping, subpixelBits_);
     // Orphan last frame's volumes so writing this frame's never waits on the rasteriser.
     // After a failed allocation both buffers are allocated again (either may have no storage).
     const bool retry = degraded_;

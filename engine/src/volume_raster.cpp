@@ -1,7 +1,9 @@
 // What the GL volume tests share (volume_raster.hpp): a volume's drawn points and
-// triangles with its snapping ring, and the raster state they are drawn in.
+// triangles with its snapping margin, and the raster state they are drawn in.
 #include "volume_raster.hpp"
 
+#include <cmath>
+#include <limits>
 #include <span>
 
 #include "dyncull/objects/convex_mesh.hpp"
@@ -34,6 +36,34 @@ std::uint32_t convexHull(std::span<const glm::dvec2> p, std::array<std::uint8_t,
     return k > 1 ? k - 1 : k;  // the last point repeats the first
 }
 
+/// Grows the box whose eye-relative corners are `rel` (corner i at centre +- half-edges
+/// a0, a1, a2 by the bits of i) by a disc across the view (see prepareVolume). The corners
+/// move, not a rebuilt box: they are a parallelepiped only to within their float rounding,
+/// which enlargedForRounding covered, and moving each face as a whole keeps that cover.
+/// False, unchanged, if the box has no three independent edges (it then gets the ring).
+bool growBoxAcrossView(std::span<glm::dvec3, 8> rel, const VolumeView& view) {
+    const glm::dvec3 a[3] = {0.5 * (rel[1] - rel[0]), 0.5 * (rel[2] - rel[0]), 0.5 * (rel[4] - rel[0])};
+    double farthestW = 0.0;
+    for (const glm::dvec3& p : rel) farthestW = std::max(farthestW, (view.viewProj * glm::dvec4(p, 1.0)).w);
+    const double radius = view.marginPixels * view.unitsPerPixel * farthestW;
+    if (!std::isfinite(radius)) return false;
+    const double volume = std::abs(glm::dot(a[0], glm::cross(a[1], a[2])));
+    glm::dvec3 move[3];
+    for (int i = 0; i < 3; ++i) {
+        const glm::dvec3 across = glm::cross(a[(i + 1) % 3], a[(i + 2) % 3]);  // the normal of faces +-i, unnormalised
+        const double area = glm::length(across);
+        if (!(area > 0.0 && volume > 0.0)) return false;
+        // Faces +-i lie volume / area from the centre; moving them out by `push` along
+        // their normal is moving their corners by push / that along a_i.
+        const double cosine = glm::dot(across, view.forward) / area;
+        const double push = radius * std::sqrt(std::max(0.0, 1.0 - cosine * cosine));
+        move[i] = a[i] * (push * area / volume);
+    }
+    for (std::uint32_t c = 0; c < 8; ++c)
+        rel[c] += ((c & 1u) ? move[0] : -move[0]) + ((c & 2u) ? move[1] : -move[1]) + ((c & 4u) ? move[2] : -move[2]);
+    return true;
+}
+
 /// Appends the snapping ring of the volume whose eye-relative points are `rel` (see
 /// prepareVolume).
 void addRing(std::span<const glm::dvec3> rel, const VolumeView& view, DrawnVolume& out) {
@@ -47,7 +77,7 @@ void addRing(std::span<const glm::dvec3> rel, const VolumeView& view, DrawnVolum
     std::array<std::uint8_t, QueryVolume::kMaxVertices> order;
     std::array<std::uint8_t, 2 * QueryVolume::kMaxVertices + 1> hull;
     const std::uint32_t h = convexHull({screen.data(), rel.size()}, order, hull);
-    const double w = view.ringPixels;
+    const double w = view.marginPixels;
     auto emit = [&](const glm::dvec2& px) {  // a ring point: back to eye-relative space at the nearest depth
         const glm::dvec4 q = view.inverseViewProj * glm::dvec4(px.x / view.width * 2.0 - 1.0, px.y / view.height * 2.0 - 1.0, nearest, 1.0);
         out.points[out.count] = glm::vec3(glm::dvec3(q) / q.w);
@@ -74,15 +104,46 @@ void addRing(std::span<const glm::dvec3> rel, const VolumeView& view, DrawnVolum
 
 }  // namespace
 
+VolumeView VolumeView::of(const FrameView& frame, SnappingMargin margin, int subpixelBits) {
+    VolumeView v;
+    const Camera& camera = frame.camera;
+    v.eye = glm::dvec3(camera.position);
+    v.forward = glm::dvec3(camera.forward());
+    v.nearPlane = double(camera.nearPlane);
+    v.viewProj = frame.viewProjRelative;
+    v.inverseViewProj = frame.inverseViewProjRelative;
+    v.width = frame.width;
+    v.height = frame.height;
+    v.margin = margin;
+    v.marginPixels = margin == SnappingMargin::None ? 0.0 : marginWidth(subpixelBits);
+    v.unitsPerPixel = unitsPerPixelAcrossView(v.viewProj, v.forward, v.width, v.height);
+    return v;
+}
+
+double unitsPerPixelAcrossView(const glm::dmat4& viewProj, const glm::dvec3& forward, double width, double height) {
+    // Rows 0 and 1 (pixels per unit of clip x, y / w), without their part along `forward`.
+    const glm::dvec3 row0(viewProj[0][0], viewProj[1][0], viewProj[2][0]), row1(viewProj[0][1], viewProj[1][1], viewProj[2][1]);
+    const glm::dvec3 x = 0.5 * width * (row0 - glm::dot(row0, forward) * forward);
+    const glm::dvec3 y = 0.5 * height * (row1 - glm::dot(row1, forward) * forward);
+    // The smallest singular value: the square root of the Gram matrix's smaller eigenvalue.
+    const double xx = glm::dot(x, x), yy = glm::dot(y, y), xy = glm::dot(x, y);
+    const double half = 0.5 * (xx + yy), det = xx * yy - xy * xy;
+    const double smallest = det / (half + std::sqrt(std::max(0.0, half * half - det)));  // no cancellation
+    return smallest > 0.0 ? 1.0 / std::sqrt(smallest) : std::numeric_limits<double>::infinity();
+}
+
 bool prepareVolume(const QueryVolume& volume, const VolumeView& view, DrawnVolume& out) {
     std::array<glm::dvec3, QueryVolume::kMaxVertices> rel;
     bool asBox = false;
     out.count = volume.enlargedForRounding(view.eye, rel, asBox);
+    const bool box = asBox || volume.isBox();
+    const bool grown = box && view.margin == SnappingMargin::GrowBoxes && view.marginPixels > 0.0 &&
+                       growBoxAcrossView(std::span<glm::dvec3, 8>(rel.data(), 8), view);
     for (std::uint32_t i = 0; i < out.count; ++i) {
         if (glm::dot(rel[i], view.forward) < view.nearPlane) return false;
         out.points[i] = glm::vec3(rel[i]);
     }
-    const std::span<const std::uint8_t> tris = asBox || volume.isBox() ? std::span<const std::uint8_t>(kBoxTriangles) : volume.triangles();
+    const std::span<const std::uint8_t> tris = box ? std::span<const std::uint8_t>(kBoxTriangles) : volume.triangles();
     // Only front faces are drawn (VolumeTestState): they cover the whole outline of a
     // convex volume seen from outside (one reaching the near plane was answered above),
     // and a back face lies behind the front face of its pixel. Each face is wound outward
@@ -99,7 +160,7 @@ bool prepareVolume(const QueryVolume& volume, const VolumeView& view, DrawnVolum
         out.indices[k + 2] = tris[inward ? k + 1 : k + 2];
     }
     out.indexCount = static_cast<std::uint32_t>(tris.size());
-    if (view.ringPixels > 0.0) addRing({rel.data(), out.count}, view, out);
+    if (!grown && view.marginPixels > 0.0) addRing({rel.data(), out.count}, view, out);
     return true;
 }
 

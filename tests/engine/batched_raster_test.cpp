@@ -178,9 +178,10 @@ std::vector<glm::ivec2> coveredPixels(Renderer& r, int w, int h) {
 // edge can cover a pixel centre just outside its exact outline, and the edge of a tight
 // volume through the same line, snapped on its own, can miss it. Each random triangle gets
 // a box with one face through its edge AB; each of its pixels alone is left uncovered by a
-// nearer depth, and a hardware query of the box must see it. Without the snapping ring
-// some pixels are missed (the test shows the case exists); with it none is.
-TEST(VolumeSnapping, TheRingKeepsEveryPixelOfAPartInsideItsVolume) {
+// nearer depth, and a hardware query of the box must see it. Without a snapping margin
+// some pixels are missed (the test shows the case exists); with it, or with the box grown
+// across the view direction instead (the default for boxes), none is.
+TEST(VolumeSnapping, TheMarginKeepsEveryPixelOfAPartInsideItsVolume) {
     constexpr int kSize = 64;
     auto ctx = test::headless(kSize, kSize);
     ASSERT_TRUE(ctx);
@@ -190,10 +191,10 @@ TEST(VolumeSnapping, TheRingKeepsEveryPixelOfAPartInsideItsVolume) {
     const Camera cam = test::cameraOnZ(3.0f);
     std::mt19937 rng(7);
     std::uniform_real_distribution<float> coord(-0.9f, 0.9f), angle(0.0f, 6.2832f), len(0.3f, 0.9f), height(0.05f, 0.3f);
-    std::uint32_t missedWithout = 0, missedWith = 0, pixels = 0;
-    for (bool ring : {false, true}) {
+    std::uint32_t missedWithout = 0, missedRing = 0, missedGrown = 0, pixels = 0;
+    for (SnappingMargin margin : {SnappingMargin::None, SnappingMargin::Ring, SnappingMargin::GrowBoxes}) {
         GlQueryParams qp;
-        qp.snappingRing = ring;
+        qp.snapping = margin;
         auto backendOr = GlQueryBackend::create(*ctx, qp);
         ASSERT_TRUE(backendOr.ok()) << backendOr.error().message;
         GlQueryBackend& b = **backendOr;
@@ -260,16 +261,120 @@ TEST(VolumeSnapping, TheRingKeepsEveryPixelOfAPartInsideItsVolume) {
                 const bool seen = b.wait(q, 10000.0) == QueryResult::Visible;
                 b.release(q);
                 r.endFrame();
-                if (!seen) ++(ring ? missedWith : missedWithout);
-                if (ring) ++pixels;
+                if (!seen) ++(margin == SnappingMargin::None ? missedWithout : margin == SnappingMargin::Ring ? missedRing : missedGrown);
+                if (margin == SnappingMargin::None) ++pixels;
             }
         }
     }
-    std::printf("%u triangle pixels near the shared edge: %u missed by the tight volume alone, %u with the snapping ring\n", pixels,
-                missedWithout, missedWith);
+    std::printf("%u triangle pixels near the shared edge: %u missed by the tight volume alone, %u with the snapping ring, %u with "
+                "the box grown across the view\n",
+                pixels, missedWithout, missedRing, missedGrown);
     EXPECT_GT(pixels, 100u);
-    EXPECT_GT(missedWithout, 0u) << "the case the ring exists for should occur";
-    EXPECT_EQ(missedWith, 0u);
+    EXPECT_GT(missedWithout, 0u) << "the case the margin exists for should occur";
+    EXPECT_EQ(missedRing, 0u);
+    EXPECT_EQ(missedGrown, 0u);
+    EXPECT_EQ(ctx->checkErrors(), 0u);
+}
+
+// The default margin grows a box across the view direction (prepareVolume) by a disc whose
+// radius scales with the box's farthest clip w. Its outline must then reach a pixel centre
+// 0.006 px outside its exact outline (more than a snapping step, less than the margin),
+// under a rotated perspective camera and an orthographic one, on every side of a
+// non-square view; without a margin each such centre is missed, so the case is real.
+TEST(VolumeSnapping, GrownBoxesReachPixelCentresJustOutsideTheirOutline) {
+    constexpr int kWidth = 96, kHeight = 48;
+    constexpr double kOutside = 0.006;  // pixels
+    auto ctx = test::headless(kWidth, kHeight);
+    ASSERT_TRUE(ctx);
+    auto made = Renderer::create(*ctx);
+    ASSERT_TRUE(made.ok()) << made.error().message;
+    Renderer& r = **made;
+    Camera perspective;
+    perspective.position = {1.5f, -2.0f, 4.0f};
+    perspective.target = {0.3f, 0.2f, -1.0f};
+    perspective.up = glm::normalize(glm::vec3(0.3f, 1.0f, 0.1f));
+    perspective.aspect = float(kWidth) / float(kHeight);
+    perspective.nearPlane = 0.1f;
+    perspective.farPlane = 100.0f;
+    Camera orthographic = perspective;
+    orthographic.orthoHeight = 3.0f;
+    std::mt19937 rng(11);
+    for (const Camera& cam : {perspective, orthographic}) {
+        const glm::dmat4 toWorld = glm::inverse(glm::dmat4(cam.view()));
+        const glm::dmat4 vp = cam.viewProjectionRelativeDouble();
+        const glm::dvec2 size(kWidth, kHeight);
+        auto pixelOf = [&](const glm::dvec3& viewPoint) {  // pixels, y up
+            const glm::dvec4 clip = vp * glm::dvec4(glm::dvec3(toWorld * glm::dvec4(viewPoint, 1.0)) - glm::dvec3(cam.position), 1.0);
+            return (glm::dvec2(clip) / clip.w + 1.0) * 0.5 * size;
+        };
+        // The view-space coordinate on `axis` at depth z whose image lies at pixel coordinate
+        // `px` (the image is affine in it at a fixed depth).
+        auto viewCoordAt = [&](int axis, double px, double z) {
+            glm::dvec3 p0(0.0, 0.0, z), p1(0.0, 0.0, z);
+            p1[axis] = 1.0;
+            const double a = pixelOf(p0)[axis], b = pixelOf(p1)[axis];
+            return (px - a) / (b - a);
+        };
+        std::uint32_t missed[3] = {0, 0, 0};
+        const SnappingMargin margins[3] = {SnappingMargin::None, SnappingMargin::Ring, SnappingMargin::GrowBoxes};
+        constexpr int kTrials = 40;
+        for (int m = 0; m < 3; ++m) {
+            GlQueryParams qp;
+            qp.snapping = margins[m];
+            auto backendOr = GlQueryBackend::create(*ctx, qp);
+            ASSERT_TRUE(backendOr.ok()) << backendOr.error().message;
+            GlQueryBackend& b = **backendOr;
+            rng.seed(11);
+            std::uniform_int_distribution<int> px(4, kWidth - 5), py(4, kHeight - 5);
+            std::uniform_real_distribution<double> nearDepth(2.0, 6.0), deep(0.3, 2.0), wide(1.0, 6.0);
+            for (int trial = 0; trial < kTrials; ++trial) {
+                const glm::ivec2 p(px(rng), py(rng));
+                const int axis = trial % 2, other = 1 - axis;
+                const double zNear = -nearDepth(rng), zFar = zNear - deep(rng);
+                // The box lies toward the view's centre from the pixel, with its edge on `axis`
+                // just short of the pixel centre: for a perspective camera that edge of the
+                // outline is the near face's.
+                const glm::dvec2 centre = glm::dvec2(p) + 0.5;
+                const double side = centre[axis] > 0.5 * size[axis] ? 1.0 : -1.0;
+                const double edge = viewCoordAt(axis, centre[axis] - side * kOutside, zNear);
+                const double inner = viewCoordAt(axis, centre[axis] - side * wide(rng), zNear);
+                const double across0 = viewCoordAt(other, centre[other] - 3.0, zNear), across1 = viewCoordAt(other, centre[other] + 3.0, zNear);
+                glm::dvec3 lo, hi;
+                lo[axis] = std::min(edge, inner);
+                hi[axis] = std::max(edge, inner);
+                lo[other] = std::min(across0, across1);
+                hi[other] = std::max(across0, across1);
+                lo.z = zFar;
+                hi.z = zNear;
+                const QueryVolume volume = QueryVolume::fromTransformedBox(glm::mat4(toWorld), Aabb::fromMinMax(glm::vec3(lo), glm::vec3(hi)));
+
+                ctx->clearFramebuffer(Renderer::kClearColour);
+                r.beginFrame(cam);
+                // Everything but pixel p nearest (reversed Z: 1), so only p can pass.
+                glEnable(GL_SCISSOR_TEST);
+                glClearDepth(1.0);
+                for (const glm::ivec4 rect : {glm::ivec4(0, 0, kWidth, p.y), glm::ivec4(0, p.y + 1, kWidth, kHeight - p.y - 1),
+                                              glm::ivec4(0, p.y, p.x, 1), glm::ivec4(p.x + 1, p.y, kWidth - p.x - 1, 1)}) {
+                    if (rect.z <= 0 || rect.w <= 0) continue;
+                    glScissor(rect.x, rect.y, rect.z, rect.w);
+                    glClear(GL_DEPTH_BUFFER_BIT);
+                }
+                glDisable(GL_SCISSOR_TEST);
+                glClearDepth(0.0);
+                b.beginFrame(FrameView::of(cam, kWidth, kHeight));
+                b.beginBatch();
+                const QueryId q = b.issue(volume);
+                b.endBatch();
+                if (b.wait(q, 10000.0) != QueryResult::Visible) ++missed[m];
+                b.release(q);
+                r.endFrame();
+            }
+        }
+        SCOPED_TRACE(cam.orthographic() ? "orthographic" : "perspective");
+        EXPECT_EQ(missed[0], std::uint32_t(kTrials)) << "without a margin every centre just outside is missed";
+        EXPECT_EQ(missed[1], 0u) << "the ring";
+        EXPECT_EQ(missed[2], 0u) << "the box grown across the view";
+    }
     EXPECT_EQ(ctx->checkErrors(), 0u);
 }
 

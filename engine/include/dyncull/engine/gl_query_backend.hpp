@@ -24,17 +24,27 @@ class BatchedRasterTest;
 struct VolumeView;
 }  // namespace detail
 
+/// What a volume test adds around a volume's outline for the rasteriser's vertex snapping.
+enum class SnappingMargin : std::uint8_t {
+    /// Boxes grown across the view direction (their faces facing the eye stay put), other
+    /// volumes ringed: the default, and half a box test's triangles.
+    GrowBoxes,
+    /// Every volume ringed: a flat strip along its screen outline at its nearest depth.
+    Ring,
+    /// Nothing: not conservative, only to measure what the margin costs and catches.
+    None,
+};
+
 struct GlQueryParams {
     std::uint32_t visiblePixelThreshold = 0;  ///< 0 = conservative (any sample passes)
     /// glFlush at the end of every batch so the GPU starts on the queries while the CPU
     /// traverses on. On llvmpipe each flush ends a binned scene; off, the first poll of
     /// the batch submits it instead.
     bool flushAfterBatch = true;
-    /// Lay a flat ring a few 1/256 pixel wide around every volume's screen outline, at the
-    /// volume's nearest depth (detail::prepareVolume): the rasteriser's vertex snapping can
-    /// let a part cover a pixel centre just outside its tight volume's outline. Off only to
-    /// measure what the ring costs and what it catches.
-    bool snappingRing = true;
+    /// How each volume's screen outline is widened by a few 1/256 pixel, because the
+    /// rasteriser's vertex snapping can let a part cover a pixel centre just outside its
+    /// tight volume's outline (detail::prepareVolume).
+    SnappingMargin snapping = SnappingMargin::GrowBoxes;
 };
 
 /// Owns GL query objects, a streaming vertex buffer for volumes and a depth-only program.
