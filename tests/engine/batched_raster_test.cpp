@@ -174,6 +174,21 @@ std::vector<glm::ivec2> coveredPixels(Renderer& r, int w, int h) {
     return out;
 }
 
+/// Sets every pixel's depth but p's to the nearest (reversed Z: 1), so only p can pass a
+/// volume test.
+void nearestExceptPixel(glm::ivec2 p, int w, int h) {
+    glEnable(GL_SCISSOR_TEST);
+    glClearDepth(1.0);
+    for (const glm::ivec4 rect : {glm::ivec4(0, 0, w, p.y), glm::ivec4(0, p.y + 1, w, h - p.y - 1), glm::ivec4(0, p.y, p.x, 1),
+                                  glm::ivec4(p.x + 1, p.y, w - p.x - 1, 1)}) {
+        if (rect.z <= 0 || rect.w <= 0) continue;
+        glScissor(rect.x, rect.y, rect.z, rect.w);
+        glClear(GL_DEPTH_BUFFER_BIT);
+    }
+    glDisable(GL_SCISSOR_TEST);
+    glClearDepth(0.0);
+}
+
 // The rasteriser snaps window coordinates to 1/256 pixel (llvmpipe), so a part's slanted
 // edge can cover a pixel centre just outside its exact outline, and the edge of a tight
 // volume through the same line, snapped on its own, can miss it. Each random triangle gets
@@ -243,17 +258,7 @@ TEST(VolumeSnapping, TheMarginKeepsEveryPixelOfAPartInsideItsVolume) {
                 ctx->clearFramebuffer(Renderer::kClearColour);
                 r.beginFrame(cam);
                 r.drawMesh(id, glm::mat4(1.0f), {1, 1, 1});
-                // Everything but pixel p nearest (reversed Z: 1), so only p can pass.
-                glEnable(GL_SCISSOR_TEST);
-                glClearDepth(1.0);
-                for (const glm::ivec4 rect : {glm::ivec4(0, 0, kSize, p.y), glm::ivec4(0, p.y + 1, kSize, kSize - p.y - 1),
-                                              glm::ivec4(0, p.y, p.x, 1), glm::ivec4(p.x + 1, p.y, kSize - p.x - 1, 1)}) {
-                    if (rect.z <= 0 || rect.w <= 0) continue;
-                    glScissor(rect.x, rect.y, rect.z, rect.w);
-                    glClear(GL_DEPTH_BUFFER_BIT);
-                }
-                glDisable(GL_SCISSOR_TEST);
-                glClearDepth(0.0);
+                nearestExceptPixel(p, kSize, kSize);
                 b.beginFrame(FrameView::of(cam, kSize, kSize));
                 b.beginBatch();
                 const QueryId q = b.issue(volume);
@@ -350,17 +355,7 @@ TEST(VolumeSnapping, GrownBoxesReachPixelCentresJustOutsideTheirOutline) {
 
                 ctx->clearFramebuffer(Renderer::kClearColour);
                 r.beginFrame(cam);
-                // Everything but pixel p nearest (reversed Z: 1), so only p can pass.
-                glEnable(GL_SCISSOR_TEST);
-                glClearDepth(1.0);
-                for (const glm::ivec4 rect : {glm::ivec4(0, 0, kWidth, p.y), glm::ivec4(0, p.y + 1, kWidth, kHeight - p.y - 1),
-                                              glm::ivec4(0, p.y, p.x, 1), glm::ivec4(p.x + 1, p.y, kWidth - p.x - 1, 1)}) {
-                    if (rect.z <= 0 || rect.w <= 0) continue;
-                    glScissor(rect.x, rect.y, rect.z, rect.w);
-                    glClear(GL_DEPTH_BUFFER_BIT);
-                }
-                glDisable(GL_SCISSOR_TEST);
-                glClearDepth(0.0);
+                nearestExceptPixel(p, kWidth, kHeight);
                 b.beginFrame(FrameView::of(cam, kWidth, kHeight));
                 b.beginBatch();
                 const QueryId q = b.issue(volume);
