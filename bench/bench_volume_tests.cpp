@@ -94,6 +94,11 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "bench_volume_tests: %s\n", (!renderer ? renderer.error() : backend.error()).message.c_str());
         return 1;
     }
+    // The backend reads depth from the frame's target, which an Engine frame reads from the
+    // caller's state; here the context's own single-sample framebuffer is that target.
+    GLint fbo = 0;
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &fbo);
+    (*backend)->setTarget({static_cast<std::uint32_t>(fbo), {0, 0, kWidth, kHeight}, true});
     Mesh wall;
     wall.name = "wall";
     const float h = 50.0f;
@@ -144,7 +149,10 @@ int main(int argc, char** argv) {
             glFinish();
             t0 = Clock::now();
             int w = 0, hgt = 0;
-            (*backend)->readDepth(depth, w, hgt);
+            if (!(*backend)->readDepth(depth, w, hgt) || w != kWidth || hgt != kHeight) {
+                std::fprintf(stderr, "bench_volume_tests: the depth buffer could not be read back\n");
+                return 1;
+            }
             if (round >= 0) readMs.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
             (*renderer)->endFrame();
             if (round < 0) continue;
