@@ -132,6 +132,10 @@ TEST(BenchModes, EverySweptValueIsInItsParametersFamily) {
     EXPECT_TRUE((*latency)[1].scheduler.approx.useLastFrameResults);
     EXPECT_EQ((*latency)[1].family, "latency");
     EXPECT_EQ(sweepModes("max-skip=2,4")->front().family, "max-skip");
+    auto testNs = sweepModes("test-ns=2700,5000");
+    ASSERT_TRUE(testNs) << testNs.error().message;
+    EXPECT_EQ((*testNs)[1].scheduler.mode, CullMode::TwoPhase);
+    EXPECT_EQ((*testNs)[1].scheduler.tuning.costs.testNsPerVolume, 5000.0);
     EXPECT_FALSE(sweepModes("latency=2"));
     EXPECT_FALSE(sweepModes("error-budget=0.1,0.1"));
 }

@@ -184,7 +184,7 @@ inline std::uint64_t errorBudgetPixels(double percent, int width, int height) {
 /// (`bench_draw_speed`: parts-clusters against parts; nothing measurable on llvmpipe).
 struct TestCosts {
     double drawNsPerTriangle = 53.0;
-    double testNsPerVolume = 5000.0;
+    double testNsPerVolume = 2700.0;
     double testNsPerPixel = 1.5;
     double triangleTestNsPerPart = 0.0;
     double triangleTestNsPerTriangle = 69.0;
