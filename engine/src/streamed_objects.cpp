@@ -45,7 +45,8 @@ struct StreamedObjects::State {
     struct Gpu {
         MeshId mesh = 0;
         bool resident = false;
-        std::uint64_t frame = 0;  // last frame it was drawn in
+        std::uint64_t frame = 0;   // last frame it was drawn in
+        std::uint64_t inView = 0;  // last frame whose current or predicted frustum held it
         std::size_t bytes = 0;
     };
     std::vector<Gpu> gpu;
@@ -66,18 +67,25 @@ struct StreamedObjects::State {
 
     std::size_t gpuBudget() const { return options.gpuBytes ? options.gpuBytes : SIZE_MAX; }
 
-    /// Releases least recently drawn leaves drawn neither this frame nor the last until
-    /// `bytes` more fit. Last frame's leaves are kept: most are drawn again later in this
-    /// frame, and releasing them for a new leaf would make each frame read them all again
-    /// when the budget is smaller than a frame's leaves (the new leaf is drawn from a
-    /// transient copy instead).
+    /// Releases leaves drawn neither this frame nor the last until `bytes` more fit: those
+    /// outside this frame's current and predicted frustums first, then the least recently
+    /// drawn. Last frame's leaves are kept: most are drawn again later in this frame, and
+    /// releasing them for a new leaf would make each frame read them all again when the
+    /// budget is smaller than a frame's leaves (the new leaf is drawn from a transient copy
+    /// instead).
     bool makeGpuRoom(std::size_t bytes) {
         while (gpuBytes + bytes > gpuBudget()) {
             std::size_t victim = SIZE_MAX;
             for (std::size_t k = 0; k < gpuResident.size(); ++k) {
                 const Gpu& g = gpu[gpuResident[k]];
                 if (g.frame + 1 >= frame) continue;
-                if (victim == SIZE_MAX || g.frame < gpu[gpuResident[victim]].frame) victim = k;
+                if (victim == SIZE_MAX) {
+                    victim = k;
+                    continue;
+                }
+                const Gpu& v = gpu[gpuResident[victim]];
+                const bool gInView = g.inView == frame, vInView = v.inView == frame;
+                if (gInView != vInView ? vInView : g.frame < v.frame) victim = k;
             }
             if (victim == SIZE_MAX) return false;
             Gpu& g = gpu[gpuResident[victim]];
@@ -263,7 +271,7 @@ void StreamedObjects::beginFrame(const Camera& camera) {
     s.previous = camera;
     const Frustum now = Frustum::fromCamera(camera), next = Frustum::fromCamera(predicted);
 
-    // A leaf in GL buffers is drawn from there: main memory is for the leaves that are not.
+    // A leaf kept in GL buffers is drawn from there: main memory is for the others.
     // Last frame's drawn leaves first (drawn again, mostly), then the leaves in either
     // frustum, found through the tree (a subtree outside both is skipped), in the order the
     // culler's history makes likely to show next: the most recently visible first (what
@@ -291,8 +299,12 @@ void StreamedObjects::beginFrame(const Camera& camera) {
             for (std::uint32_t c = 0; c < node.childCount; ++c) stack.push_back(node.firstChild + c);
             continue;
         }
+        // A leaf in GL buffers is left out only if it was drawn last frame, which keeps it
+        // there through this one (makeGpuRoom); any other may be released for this frame's
+        // leaves and then be drawn from main memory.
         const std::uint32_t leaf = s.leafOfNode[k];
-        if (s.gpu[leaf].resident) continue;
+        s.gpu[leaf].inView = s.frame;
+        if (s.gpu[leaf].resident && s.gpu[leaf].frame + 1 >= s.frame) continue;
         const glm::vec3 nearest = glm::clamp(camera.position, node.box.min, node.box.max);
         const NodeHistory* h = culler.history(NodeRef{s.objectOfLeaf[leaf].index, 0}, s.engine.objects());
         found.push_back({h && culler.testedHiddenLastFrame(*h), h ? h->lastVisibleFrame : 0u,

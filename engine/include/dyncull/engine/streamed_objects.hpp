@@ -78,7 +78,8 @@ public:
     StreamedObjects& operator=(const StreamedObjects&) = delete;
 
     /// Before a frame drawn from `camera` (world space): hands the read-ahead its list of
-    /// leaves not in GL buffers: those drawn last frame first, then those in the current or
+    /// leaves not kept in GL buffers through the frame (only last frame's leaves are kept):
+    /// those drawn last frame first, then those in the current or
     /// predicted frustum, ordered by the main view's culler history (most recently visible,
     /// then tested hidden last frame) and then nearest first. A culler without history for
     /// the leaves (another scheduler culls them) leaves the order nearest first.
