@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <functional>
@@ -17,6 +18,7 @@
 #include "dyncull/bsp/traversal.hpp"
 #include "dyncull/scheduler/query_scheduler.hpp"
 #include "objects/sphere_grid.hpp"
+#include "screen_projection.hpp"
 
 using namespace dyncull;
 
@@ -932,6 +934,8 @@ namespace {
 /// tests answered by `rule`. Counts depth reads and tested volumes.
 struct DepthBackend final : QueryBackend {
     float depth = 0.0f;
+    std::function<float(int, int)> depthAt;  // per pixel (x, y from the lower left) if set
+
     std::function<QueryResult(const QueryVolume&)> rule = [](const QueryVolume&) { return QueryResult::Visible; };
     int reads = 0, tested = 0;
     std::vector<std::vector<QueryResult>> answers;  // per batch, until collected
@@ -948,6 +952,9 @@ struct DepthBackend final : QueryBackend {
         w = 640;
         h = 320;
         d.assign(std::size_t{640} * 320, depth);
+        if (depthAt)
+            for (int y = 0; y < h; ++y)
+                for (int x = 0; x < w; ++x) d[std::size_t(y) * std::size_t(w) + std::size_t(x)] = depthAt(x, y);
         return true;
     }
     BatchId testVolumes(std::span<const QueryVolume> volumes, bool = false) override {
@@ -1123,4 +1130,55 @@ TEST(VisibilityHistory, ClusterBitsFollowTheObjectInTheirSlot) {
     EXPECT_TRUE(std::all_of(bits.begin(), bits.end(), [](std::uint64_t w) { return w == 0; }));
     history.clear();
     EXPECT_EQ(history.clusterBits(b.index, objects).size(), bits.size());
+}
+
+// The read-ahead's guess: with the left half of the screen hidden behind a near wall and
+// the right half open, a hidden box shows after growing by about its pixel distance to the
+// wall's edge (the pyramid reads a superset of the grown rectangle, so up to that distance
+// rounded up to a power of two, never more, and a coarse level may see the edge sooner);
+// a box deep behind the wall is far from showing; an open one, or one reaching the near
+// plane, shows as it is; off screen or before any pyramid, nothing is known.
+TEST(PixelsFromShowing, GrowsWithTheDistanceToTheSilhouette) {
+    TestScene s(2, 1);
+    TwoLevelTree tree(s.bsp, s.objects);
+    DepthBackend backend;
+    constexpr int kEdge = 320;
+    backend.depthAt = [](int x, int) { return x < kEdge ? 1.0f : 0.0f; };  // reversed Z: 1 is the near plane
+    QueryScheduler sched(twoPhase());
+    const Aabb probe = Aabb::fromMinMax({-0.05f, -0.05f, -5.05f}, {0.05f, 0.05f, -4.95f});
+    EXPECT_FALSE(sched.pixelsFromShowing(probe, 64)) << "no pyramid yet";
+    RecordingSink sink;
+    sched.cullFrame(tree, frontCamera(), 640, 320, backend, sink);
+
+    const FrameView view = FrameView::of(frontCamera(), 640, 320);
+    const ScreenProjection screen(view);
+    float previous = 0.0f;
+    int far = 0;
+    // Boxes 0.1 wide at depth 5, from the open half across the edge to the screen's left side.
+    for (float x = 1.0f; x > -9.0f; x -= 0.05f) {
+        const Aabb box = Aabb::fromMinMax({x - 0.05f, -0.05f, -5.05f}, {x + 0.05f, 0.05f, -4.95f});
+        ScreenRect rect;
+        ASSERT_TRUE(screen.rect(box, rect));
+        if (rect.empty() || rect.x0 <= 0) break;  // leaving the screen
+        const auto pixels = sched.pixelsFromShowing(box, 64);
+        ASSERT_TRUE(pixels) << "x " << x;
+        const int gap = kEdge - rect.x1;  // pixels between the box and the open half
+        if (gap < -1) {
+            EXPECT_EQ(*pixels, 0.0f) << "x " << x;  // over the open half
+        } else if (gap > 2) {
+            EXPECT_GT(*pixels, 0.0f) << "x " << x;
+            // (rect is padded by a pixel beyond the pixel centres the box covers)
+            if (gap + 2 <= 64) {
+                EXPECT_LE(*pixels, float(std::bit_ceil(unsigned(gap + 2)))) << "x " << x << " gap " << gap;
+            }
+        }
+        EXPECT_GE(*pixels, previous) << "further from the edge, never nearer to showing (x " << x << ")";
+        previous = *pixels;
+        far += *pixels == QueryScheduler::kFarFromShowing;
+    }
+    EXPECT_GT(far, 0) << "boxes deep behind the wall";
+    // Through the near plane: visible without a guess.
+    EXPECT_EQ(sched.pixelsFromShowing(Aabb::fromMinMax({-3.0f, -1.0f, -1.0f}, {-2.0f, 1.0f, 1.0f}), 64), 0.0f);
+    // Behind the camera, or off to the side: nothing to say.
+    EXPECT_FALSE(sched.pixelsFromShowing(Aabb::fromMinMax({40.0f, -1.0f, -6.0f}, {41.0f, 1.0f, -5.0f}), 64));
 }

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -328,6 +329,16 @@ public:
     /// The same for a record history() returned.
     bool testedHiddenLastFrame(const NodeHistory& h) const { return frame_ > 0 && h.lastQueryFrame == frame_ && !h.lastVisible; }
 
+    /// A guess for streaming's read-ahead, not a culling decision: how far world box `box`
+    /// lay from showing in the newest depth pyramid (two-phase's depth of the newest frame,
+    /// under that frame's view), in pixels: 0 if it showed there as it was, or reached the
+    /// near plane; else the first of 1, 2, 4, ... `maxPixels` by which its pixel rectangle,
+    /// grown on every side, reaches a texel farther than its nearest depth (a box hidden
+    /// just behind a silhouette shows when the view moves that far); `kFarFromShowing` if
+    /// none does. nullopt if there is no pyramid or the box lay off that frame's screen.
+    std::optional<float> pixelsFromShowing(const Aabb& box, int maxPixels) const;
+    static constexpr float kFarFromShowing = 1e30f;
+
     /// One frame's borrowed state, passed through every stage (cull_frame.hpp).
     struct Frame;
 
@@ -421,6 +432,7 @@ private:
     // frames; the parts for the batched raster test and its answers.
     std::vector<float> depth_;
     DepthPyramid pyramid_;
+    std::optional<FrameView> pyramidView_;  // the view pyramid_ was built under; none: not built
     // Parts for the batched raster test. Their volumes are rebuilt batch by batch
     // (testedVolume) rather than kept: a k-DOP is 860 bytes, and a frame without history
     // has tens of thousands of candidates.
