@@ -21,4 +21,10 @@ bool keepFreedHeapMemory() {
 #endif
 }
 
+void returnFreedHeapMemory() {
+#if defined(__GLIBC__)
+    malloc_trim(0);
+#endif
+}
+
 }  // namespace dyncull

@@ -273,17 +273,22 @@ void StreamedObjects::beginFrame(const Camera& camera) {
 
     // A leaf kept in GL buffers is drawn from there: main memory is for the others.
     // Last frame's drawn leaves first (drawn again, mostly), then the leaves in either
-    // frustum, found through the tree (a subtree outside both is skipped), in the order the
-    // culler's history makes likely to show next: the most recently visible first (what
-    // the camera passes shows again), then those last frame tested and found hidden (the
-    // traversal reached them, so they lie next to what is visible), then nearest first.
+    // frustum, found through the tree (a subtree outside both is skipped), soonest to show
+    // first by a guess in pixels of view motion: how far the leaf lay from showing in the
+    // culler's newest depth pyramid (a hidden leaf shows when a silhouette in front of it
+    // moves across it), plus a few pixels for every frame since the culler last saw it
+    // (what the camera passes shows again); ties nearest first. The weights were fitted on
+    // the plant flythrough's logged candidates (docs/BENCHMARKS.md, out of core).
+    constexpr int kMaxSlack = 64;               // pixels; a leaf further counts twice that
+    constexpr float kOffScreenSlack = 16.0f;    // off the pyramid's screen, or no pyramid
+    constexpr float kSlackPerFrame = 4.0f;      // per frame since last visible
+    constexpr std::uint32_t kMaxAge = 64;       // frames; never visible counts this
     s.wanted.clear();
     for (std::uint32_t leaf : s.urgent) s.want(leaf);
     for (std::uint32_t leaf : s.lastDrawn)
         if (!s.gpu[leaf].resident) s.want(leaf);
     struct Near {
-        bool testedHidden;
-        std::uint32_t lastVisible;  // the culler's frame it was last visible in (0: never)
+        float score;  // pixels of view motion before it shows: smaller first
         float distance;
         std::uint32_t leaf;
     };
@@ -305,15 +310,15 @@ void StreamedObjects::beginFrame(const Camera& camera) {
         const std::uint32_t leaf = s.leafOfNode[k];
         s.gpu[leaf].inView = s.frame;
         if (s.gpu[leaf].resident && s.gpu[leaf].frame + 1 >= s.frame) continue;
-        const glm::vec3 nearest = glm::clamp(camera.position, node.box.min, node.box.max);
         const NodeHistory* h = culler.history(NodeRef{s.objectOfLeaf[leaf].index, 0}, s.engine.objects());
-        found.push_back({h && culler.testedHiddenLastFrame(*h), h ? h->lastVisibleFrame : 0u,
-                         glm::distance(nearest, camera.position), leaf});
+        const std::uint32_t age = h && h->lastVisibleFrame ? std::min(culler.frameIndex() - h->lastVisibleFrame, kMaxAge) : kMaxAge;
+        const std::optional<float> slack = culler.pixelsFromShowing(node.box, kMaxSlack);
+        const float pixels = !slack ? kOffScreenSlack : std::min(*slack, 2.0f * float(kMaxSlack));
+        const glm::vec3 nearest = glm::clamp(camera.position, node.box.min, node.box.max);
+        found.push_back({pixels + kSlackPerFrame * float(age), glm::distance(nearest, camera.position), leaf});
     }
     std::sort(found.begin(), found.end(), [](const Near& a, const Near& b) {
-        if (a.lastVisible != b.lastVisible) return a.lastVisible > b.lastVisible;
-        if (a.testedHidden != b.testedHidden) return a.testedHidden;
-        return a.distance < b.distance;
+        return a.score != b.score ? a.score < b.score : a.distance < b.distance;
     });
     for (const Near& f : found) s.want(f.leaf);
     for (std::uint32_t leaf : s.wanted) s.listed[leaf] = 0;

@@ -73,11 +73,16 @@ struct LeafCache::State {
         }
         return true;
     }
+    /// The read-ahead of the leaf at list position `r` displaces only leaves further down
+    /// than this: the list is re-ranked every frame and the leaves near the budget's edge
+    /// trade places by a little each time, so a leaf is not read in place of one barely
+    /// worse placed (each swap costs a read, and gains nothing unless the order was right).
+    static std::int64_t keptAhead(std::uint32_t r) { return std::int64_t{r} + std::int64_t{r} / 4 + 256; }
     /// Reads a leaf outside the lock (the caller marked it loading, and unlocks around
     /// this), then publishes it if room allows. Lock held on entry and exit.
     Status load(std::unique_lock<std::mutex>& lock, std::uint32_t leaf, bool prefetching) {
         const std::size_t bytes = bytesOf(leaf);
-        if (!makeRoom(bytes, prefetching ? std::int64_t{rank[leaf]} : -1)) return Error{"leaf cache: the budget is full of leaves in use", ErrorCode::OutOfMemory};
+        if (!makeRoom(bytes, prefetching ? keptAhead(rank[leaf]) : -1)) return Error{"leaf cache: the budget is full of leaves in use", ErrorCode::OutOfMemory};
         // Reserve the bytes before reading, so two threads cannot both count on them.
         stats.residentBytes += bytes;
         entries[leaf].loading = true;

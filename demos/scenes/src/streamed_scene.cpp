@@ -11,6 +11,7 @@
 #include <filesystem>
 
 #include "dyncull/demos/demo_scene.hpp"
+#include "dyncull/engine/heap_tuning.hpp"
 #include "generators.hpp"
 #include "prepared_scene.hpp"
 
@@ -68,6 +69,9 @@ public:
     void setReferencePass(bool on) override { objects_->setLate(on ? StreamLate::Wait : late_); }
     Expected<std::optional<StreamingFrameStats>> endFrame() override {
         auto s = objects_->endFrame();
+        // The dyncull program keeps freed heap memory for llvmpipe's sake; the leaves this
+        // frame evicted would stay resident in it (docs/BENCHMARKS.md, out of core).
+        returnFreedHeapMemory();
         if (!s) return s.error();
         return std::optional<StreamingFrameStats>(*s);
     }

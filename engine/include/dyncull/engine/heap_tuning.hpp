@@ -14,4 +14,12 @@ namespace dyncull {
 /// whether the setting was applied.
 bool keepFreedHeapMemory();
 
+/// Gives the heap's free pages back to the system (glibc's malloc_trim), wherever in the
+/// heap they lie. For a program that keeps freed memory (keepFreedHeapMemory) and also
+/// streams geometry: a leaf cache frees and allocates leaves of every size each frame, and
+/// the free pages it leaves between live leaves would otherwise stay resident, so the
+/// process outgrows its memory budget. Call between frames; it costs a pass over the heap.
+/// Does nothing on another C library.
+void returnFreedHeapMemory();
+
 }  // namespace dyncull
