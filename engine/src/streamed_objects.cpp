@@ -41,6 +41,7 @@ struct StreamedObjects::State {
     std::vector<ObjectHandle> objectOfLeaf;
     std::optional<GeometryFile> truthFile;     // readLeaf's own handle, opened on first use
     std::vector<unsigned char> truthScratch;
+    Mesh expanded;  // the leaf being uploaded, decoded from its compact form
 
     struct Gpu {
         MeshId mesh = 0;
@@ -116,26 +117,27 @@ struct StreamedObjects::State {
             r.drawMesh(g.mesh, identity, colour);
             return;
         }
-        const Mesh* mesh = nullptr;
+        const CompactLeaf* compact = nullptr;
         if (options.late == StreamLate::Wait) {
             auto got = cache->acquire(leaf);
             if (!got) {
                 if (!error) error = got.error();
                 return;
             }
-            mesh = *got;
+            compact = *got;
         } else {
-            mesh = cache->tryAcquire(leaf);
-            if (!mesh) {
+            compact = cache->tryAcquire(leaf);
+            if (!compact) {
                 ++frameStats.late;
                 if (options.late == StreamLate::Draw) urgent.push_back(leaf);
                 return;
             }
         }
-        const std::size_t bytes = leafBytes(*mesh);
-        const bool keep = makeGpuRoom(bytes);
-        auto uploaded = r.upload(*mesh, FaceMode::TwoSided);
+        expandLeaf(*compact, expanded);
         cache->release(leaf);
+        const std::size_t bytes = leafBytes(expanded);
+        const bool keep = makeGpuRoom(bytes);
+        auto uploaded = r.upload(expanded, FaceMode::TwoSided);
         if (!uploaded) {
             if (!error) error = uploaded.error();
             return;
@@ -194,11 +196,10 @@ Expected<std::unique_ptr<StreamedObjects>> StreamedObjects::create(Engine& engin
     if (!model) return model.error();
     auto s = std::make_unique<State>(engine, options);
     s->model = model.take();
-    std::size_t total = 0, largest = 0;
+    std::size_t total = 0, largest = 0;  // main memory keeps leaves compact, GL buffers expanded
     for (const StreamedLeaf& l : s->model.leaves) {
-        const std::size_t b = leafBytes(l);
-        total += b;
-        largest = std::max(largest, b);
+        total += compactLeafBytes(l);
+        largest = std::max(largest, leafBytes(l));
     }
     if (options.gpuBytes && largest > options.gpuBytes)
         return Error{nodePath.string() + ": its largest leaf needs " + std::to_string((largest >> 20) + 1) +
@@ -366,7 +367,12 @@ Status StreamedObjects::readLeaf(std::uint32_t leaf, Mesh& out) const {
         if (!file) return file.error();
         s_->truthFile.emplace(file.take());
     }
-    return s_->truthFile->read(leaf, out, s_->truthScratch);
+    // What the draws show: the leaf through its compact form.
+    if (Status st = s_->truthFile->read(leaf, out, s_->truthScratch); !st) return st;
+    CompactLeaf compact;
+    compactLeaf(out, s_->model.leaves[leaf].box, compact);
+    expandLeaf(compact, out);
+    return {};
 }
 
 const LeafCacheStats StreamedObjects::cacheStats() const { return s_->cache->stats(); }

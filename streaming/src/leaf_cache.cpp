@@ -21,7 +21,7 @@ struct LeafCache::State {
     mutable std::mutex mutex;
     std::condition_variable wake, idle, loaded;
     struct Entry {
-        std::unique_ptr<Mesh> mesh;  // null: not resident
+        std::unique_ptr<CompactLeaf> mesh;  // null: not resident
         std::uint32_t pins = 0;
         std::uint64_t used = 0;      // clock of the last acquire
         bool loading = false;        // being read by some thread
@@ -42,7 +42,7 @@ struct LeafCache::State {
     explicit State(GeometryFile f) : file(std::move(f)) {}
 
     /// Bytes a leaf will take once read: known from the node file without reading it.
-    std::size_t bytesOf(std::uint32_t leaf) const { return leafBytes(leaves[leaf]); }
+    std::size_t bytesOf(std::uint32_t leaf) const { return compactLeafBytes(leaves[leaf]); }
     /// Evicts unpinned leaves until `bytes` more fit: first those not in the read-ahead
     /// list (least recently used first), then those furthest down it; read-ahead of the leaf
     /// at position `keepUpTo` never displaces one at or before it (a leaf needed now,
@@ -65,7 +65,7 @@ struct LeafCache::State {
             }
             if (victim == SIZE_MAX) return false;
             const std::uint32_t v = residentList[victim];
-            stats.residentBytes -= leafBytes(*entries[v].mesh);
+            stats.residentBytes -= entries[v].mesh->bytes();
             entries[v].mesh.reset();
             residentList[victim] = residentList.back();
             residentList.pop_back();
@@ -87,9 +87,14 @@ struct LeafCache::State {
         stats.residentBytes += bytes;
         entries[leaf].loading = true;
         lock.unlock();
-        auto mesh = std::make_unique<Mesh>();
-        std::vector<unsigned char> scratch;
-        const Status st = file.read(leaf, *mesh, scratch);
+        auto mesh = std::make_unique<CompactLeaf>();
+        Status st;
+        {
+            Mesh decoded;
+            std::vector<unsigned char> scratch;
+            st = file.read(leaf, decoded, scratch);
+            if (st) compactLeaf(decoded, leaves[leaf].box, *mesh);
+        }
         lock.lock();
         entries[leaf].loading = false;
         loaded.notify_all();
@@ -171,7 +176,7 @@ void LeafCache::prefetch(std::span<const std::uint32_t> leaves) {
     s_->wake.notify_all();
 }
 
-Expected<const Mesh*> LeafCache::acquire(std::uint32_t leaf) {
+Expected<const CompactLeaf*> LeafCache::acquire(std::uint32_t leaf) {
     State& s = *s_;
     if (leaf >= s.entries.size()) return Error{"leaf cache: no leaf " + std::to_string(leaf), ErrorCode::BadArgument};
     std::unique_lock lock(s.mutex);
@@ -194,7 +199,7 @@ Expected<const Mesh*> LeafCache::acquire(std::uint32_t leaf) {
     return e.mesh.get();
 }
 
-const Mesh* LeafCache::tryAcquire(std::uint32_t leaf) {
+const CompactLeaf* LeafCache::tryAcquire(std::uint32_t leaf) {
     State& s = *s_;
     if (leaf >= s.entries.size()) return nullptr;
     std::lock_guard lock(s.mutex);

@@ -343,15 +343,18 @@ protected:
         for (std::uint32_t i = 0; i < model_.leaves.size(); ++i) {
             Mesh g;
             ASSERT_TRUE(file->read(i, g, scratch).ok());
-            total_ += leafBytes(g);
-            largest_ = std::max(largest_, leafBytes(g));
-            truth_.push_back(std::move(g));
+            CompactLeaf c;  // the cache keeps leaves compact
+            compactLeaf(g, model_.leaves[i].box, c);
+            ASSERT_EQ(c.bytes(), compactLeafBytes(model_.leaves[i]));
+            total_ += c.bytes();
+            largest_ = std::max(largest_, c.bytes());
+            truth_.push_back(std::move(c));
         }
         ASSERT_GE(truth_.size(), 8u);
     }
     test::TempDir dir_;
     StreamedModel model_;
-    std::vector<Mesh> truth_;
+    std::vector<CompactLeaf> truth_;
     std::size_t total_ = 0, largest_ = 0;
 };
 
@@ -372,8 +375,7 @@ TEST_F(LeafCacheTest, ReadAheadAndDemandLoadsStayWithinTheBudget) {
         const std::uint32_t leaf = (k * 7) % static_cast<std::uint32_t>(all.size());
         auto g = (*cache)->acquire(leaf);
         ASSERT_TRUE(g.ok()) << g.error().message;
-        EXPECT_EQ((*g)->positions, truth_[leaf].positions);
-        EXPECT_EQ((*g)->indices, truth_[leaf].indices);
+        EXPECT_EQ((*g)->words, truth_[leaf].words);
         (*cache)->release(leaf);
         ASSERT_LE((*cache)->stats().residentBytes, budget);
     }
@@ -391,7 +393,7 @@ TEST_F(LeafCacheTest, PinnedLeavesStayAndAFullBudgetOfPinsIsAnError) {
     auto a = (*cache)->acquire(0);
     auto b = (*cache)->acquire(1);
     ASSERT_TRUE(a.ok() && b.ok());
-    const Mesh* pa = *a;
+    const CompactLeaf* pa = *a;
     // Other leaves come and go through the one free slot; the pinned two stay untouched.
     for (std::uint32_t i = 2; i < truth_.size(); ++i) {
         auto g = (*cache)->acquire(i);
@@ -399,15 +401,15 @@ TEST_F(LeafCacheTest, PinnedLeavesStayAndAFullBudgetOfPinsIsAnError) {
         (*cache)->release(i);
     }
     EXPECT_TRUE((*cache)->resident(0) && (*cache)->resident(1));
-    EXPECT_EQ(pa->positions, truth_[0].positions);
+    EXPECT_EQ(pa->words, truth_[0].words);
     // Pin a third leaf, then ask for a fourth: no room, and nothing pinned may go.
     auto c = (*cache)->acquire(2);
     ASSERT_TRUE(c.ok());
     std::uint32_t big = 3;
     for (std::uint32_t i = 3; i < truth_.size(); ++i)
-        if (leafBytes(truth_[i]) > leafBytes(truth_[big])) big = i;
-    const std::size_t used = leafBytes(truth_[0]) + leafBytes(truth_[1]) + leafBytes(truth_[2]);
-    if (used + leafBytes(truth_[big]) > 3 * largest_) {
+        if (truth_[i].bytes() > truth_[big].bytes()) big = i;
+    const std::size_t used = truth_[0].bytes() + truth_[1].bytes() + truth_[2].bytes();
+    if (used + truth_[big].bytes() > 3 * largest_) {
         auto d = (*cache)->acquire(big);
         ASSERT_FALSE(d.ok());
         EXPECT_EQ(d.error().code, ErrorCode::OutOfMemory);
@@ -432,13 +434,13 @@ TEST_F(LeafCacheTest, ReadAheadAndTheRenderThreadAtOnce) {
         (*cache)->prefetch(order);
         for (std::uint32_t k = 0; k < 6; ++k) {
             const std::uint32_t leaf = order[(k * 11) % order.size()];
-            if (const Mesh* g = (*cache)->tryAcquire(leaf)) {
-                EXPECT_EQ(g->indices.size(), truth_[leaf].indices.size());
+            if (const CompactLeaf* g = (*cache)->tryAcquire(leaf)) {
+                EXPECT_EQ(g->triangleCount, truth_[leaf].triangleCount);
                 (*cache)->release(leaf);
             }
             auto g = (*cache)->acquire(leaf);
             ASSERT_TRUE(g.ok()) << g.error().message;
-            EXPECT_EQ((*g)->positions, truth_[leaf].positions);
+            EXPECT_EQ((*g)->words, truth_[leaf].words);
             (*cache)->release(leaf);
         }
     }

@@ -31,8 +31,9 @@ const char* toString(StreamLate late);
 Expected<StreamLate> parseStreamLate(const std::string& name);
 
 struct StreamingOptions {
-    /// Leaf geometry in main memory, bytes (LeafCache budget). 0: every leaf is read at
-    /// creation and stays (in core, the reference streaming is measured against).
+    /// Leaf geometry in main memory, bytes (LeafCache budget; leaves are kept compact,
+    /// CompactLeaf: 10 bytes a vertex, 6 or 12 a triangle). 0: every leaf is read at creation
+    /// and stays (in core, the reference streaming is measured against).
     std::size_t memoryBytes = std::size_t{256} << 20;
     /// Leaf geometry in GL buffers, bytes; 0: no limit.
     std::size_t gpuBytes = std::size_t{64} << 20;
@@ -96,7 +97,9 @@ public:
     std::optional<std::uint32_t> leafOf(ObjectHandle object) const;
     /// The leaf the object in slot `slot` shows, if it is one of this set's.
     std::optional<std::uint32_t> leafOfSlot(std::uint32_t slot) const;
-    /// Reads a leaf straight from the file, outside both budgets and counters (ground truth).
+    /// Reads a leaf straight from the file, outside both budgets and counters (ground truth),
+    /// as the draws show it (through its compact form: positions within half a 16-bit step of
+    /// the file's; compact_leaf.hpp).
     Status readLeaf(std::uint32_t leaf, Mesh& out) const;
     /// Totals since creation.
     const LeafCacheStats cacheStats() const;

@@ -13,6 +13,7 @@
 
 #include "dyncull/objects/error.hpp"
 #include "dyncull/objects/mesh.hpp"
+#include "dyncull/streaming/compact_leaf.hpp"
 #include "dyncull/streaming/streamed_model.hpp"
 
 namespace dyncull {
@@ -26,7 +27,7 @@ struct LeafCacheStats {
     std::uint64_t hits = 0;          ///< acquire() found the leaf resident
     std::uint64_t misses = 0;        ///< acquire() did not: read at once, or not at all (tryAcquire)
     double stallMs = 0.0;            ///< time acquire() spent reading on the caller's thread
-    std::size_t residentBytes = 0;   ///< now (leafBytes of every resident leaf)
+    std::size_t residentBytes = 0;   ///< now (CompactLeaf::bytes of every resident leaf)
     std::size_t peakResidentBytes = 0;
 };
 
@@ -34,8 +35,9 @@ struct LeafCacheStats {
 /// until release(), so the caller may read it (e.g. upload it) without holding a lock.
 class LeafCache {
 public:
-    /// Opens `model`'s geometry file; `budgetBytes` bounds leafBytes of the resident
-    /// leaves at every moment. Error: a leaf alone larger than the budget (naming it and
+    /// Opens `model`'s geometry file; `budgetBytes` bounds the bytes of the resident leaves
+    /// (CompactLeaf: leaves are kept compact, and compactLeafBytes tells their size before
+    /// they are read) at every moment. Error: a leaf alone larger than the budget (naming it and
     /// the budget it needs), or the file not opening.
     static Expected<std::unique_ptr<LeafCache>> create(const StreamedModel& model, std::size_t budgetBytes);
     ~LeafCache();
@@ -47,12 +49,12 @@ public:
     /// recently used first), then those further down it, never pinned ones; it stops at the
     /// first leaf that does not fit. A leaf needed now evicts in the same order. Returns at once.
     void prefetch(std::span<const std::uint32_t> leaves);
-    /// The leaf's geometry, pinned; read at once on this thread when not resident (counted
-    /// as a miss and stall time). Errors: the leaf's chunk is corrupt (naming the file and
-    /// the leaf), or the budget is full of pinned leaves.
-    Expected<const Mesh*> acquire(std::uint32_t leaf);
+    /// The leaf's geometry (compact: expandLeaf decodes it), pinned; read at once on this
+    /// thread when not resident (counted as a miss and stall time). Errors: the leaf's chunk
+    /// is corrupt (naming the file and the leaf), or the budget is full of pinned leaves.
+    Expected<const CompactLeaf*> acquire(std::uint32_t leaf);
     /// The leaf's geometry pinned if resident, else nullptr (a miss; nothing is read).
-    const Mesh* tryAcquire(std::uint32_t leaf);
+    const CompactLeaf* tryAcquire(std::uint32_t leaf);
     /// Unpins a leaf acquire() or tryAcquire() returned.
     void release(std::uint32_t leaf);
     /// Whether the leaf is resident now (no pin, no counting).
