@@ -17,7 +17,10 @@ namespace {
 constexpr float kSteps = 65535.0f;
 
 std::uint16_t quantise(float unit) {  // [0, 1] to the nearest of 65,536 steps
-    return static_cast<std::uint16_t>(std::lround(std::clamp(unit, 0.0f, 1.0f) * kSteps));
+    // Non-negative, so adding a half and truncating rounds to nearest (lround is a call).
+    // The clamp's comparisons also turn NaN into 0.
+    const float clamped = unit > 0.0f ? std::min(unit, 1.0f) : 0.0f;
+    return static_cast<std::uint16_t>(clamped * kSteps + 0.5f);
 }
 
 float signNotZero(float v) { return v < 0.0f ? -1.0f : 1.0f; }
