@@ -21,7 +21,7 @@ struct LeafCache::State {
     mutable std::mutex mutex;
     std::condition_variable wake, idle, loaded;
     struct Entry {
-        std::unique_ptr<CompactLeaf> mesh;  // null: not resident
+        std::unique_ptr<CompactLeaf> geometry;  // null: not resident
         std::uint32_t pins = 0;
         std::uint64_t used = 0;      // clock of the last acquire
         bool loading = false;        // being read by some thread
@@ -32,7 +32,7 @@ struct LeafCache::State {
     /// takes unwanted leaves first (least recently used first), then the furthest down.
     std::vector<std::uint32_t> rank;
     static constexpr std::uint32_t kNotWanted = 0xffffffffu;
-    std::vector<std::uint32_t> residentList;  // leaves with a mesh, in no order
+    std::vector<std::uint32_t> residentList;  // leaves with geometry, in no order
     std::size_t next = 0;               // position in `wanted`
     std::uint64_t clock = 0;
     bool busy = false, stop = false;
@@ -65,8 +65,8 @@ struct LeafCache::State {
             }
             if (victim == SIZE_MAX) return false;
             const std::uint32_t v = residentList[victim];
-            stats.residentBytes -= entries[v].mesh->bytes();
-            entries[v].mesh.reset();
+            stats.residentBytes -= entries[v].geometry->bytes();
+            entries[v].geometry.reset();
             residentList[victim] = residentList.back();
             residentList.pop_back();
             ++stats.evictions;
@@ -87,13 +87,13 @@ struct LeafCache::State {
         stats.residentBytes += bytes;
         entries[leaf].loading = true;
         lock.unlock();
-        auto mesh = std::make_unique<CompactLeaf>();
+        auto compact = std::make_unique<CompactLeaf>();
         Status st;
         {
             Mesh decoded;
             std::vector<unsigned char> scratch;
             st = file.read(leaf, decoded, scratch);
-            if (st) compactLeaf(decoded, leaves[leaf].box, *mesh);
+            if (st) compactLeaf(decoded, leaves[leaf].box, *compact);
         }
         lock.lock();
         entries[leaf].loading = false;
@@ -102,7 +102,7 @@ struct LeafCache::State {
             stats.residentBytes -= bytes;
             return st;
         }
-        entries[leaf].mesh = std::move(mesh);
+        entries[leaf].geometry = std::move(compact);
         residentList.push_back(leaf);
         ++stats.loads;
         if (prefetching) ++stats.prefetchLoads;
@@ -119,7 +119,7 @@ struct LeafCache::State {
             const std::uint32_t leaf = wanted[next];
             ++next;
             Entry& e = entries[leaf];
-            if (!e.mesh && !e.loading) {
+            if (!e.geometry && !e.loading) {
                 // Full of wanted leaves: nothing further down the list may displace them. (A
                 // bad chunk is skipped here and reported when the leaf is acquired.)
                 if (Status st = load(lock, leaf, true); !st && st.error().code == ErrorCode::OutOfMemory)
@@ -182,21 +182,21 @@ Expected<const CompactLeaf*> LeafCache::acquire(std::uint32_t leaf) {
     std::unique_lock lock(s.mutex);
     State::Entry& e = s.entries[leaf];
     e.used = ++s.clock;
-    if (e.mesh) {
+    if (e.geometry) {
         ++s.stats.hits;
         ++e.pins;
-        return e.mesh.get();
+        return e.geometry.get();
     }
     ++s.stats.misses;
     const auto t0 = std::chrono::steady_clock::now();
     // The loader thread is reading it: wait for that read rather than read it twice.
     s.loaded.wait(lock, [&] { return !e.loading; });
     Status st;
-    if (!e.mesh) st = s.load(lock, leaf, false);
+    if (!e.geometry) st = s.load(lock, leaf, false);
     s.stats.stallMs += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (!st) return st.error();
     ++e.pins;
-    return e.mesh.get();
+    return e.geometry.get();
 }
 
 const CompactLeaf* LeafCache::tryAcquire(std::uint32_t leaf) {
@@ -205,13 +205,13 @@ const CompactLeaf* LeafCache::tryAcquire(std::uint32_t leaf) {
     std::lock_guard lock(s.mutex);
     State::Entry& e = s.entries[leaf];
     e.used = ++s.clock;
-    if (!e.mesh) {
+    if (!e.geometry) {
         ++s.stats.misses;
         return nullptr;
     }
     ++s.stats.hits;
     ++e.pins;
-    return e.mesh.get();
+    return e.geometry.get();
 }
 
 void LeafCache::release(std::uint32_t leaf) {
@@ -221,7 +221,7 @@ void LeafCache::release(std::uint32_t leaf) {
 
 bool LeafCache::resident(std::uint32_t leaf) const {
     std::lock_guard lock(s_->mutex);
-    return leaf < s_->entries.size() && s_->entries[leaf].mesh != nullptr;
+    return leaf < s_->entries.size() && s_->entries[leaf].geometry != nullptr;
 }
 
 void LeafCache::drain() {
