@@ -107,6 +107,7 @@ std::vector<ModeSummary> summarise(const BenchResult& r) {
             s.depthReadMs += f.stats.depthReadMs;
             s.rasterTests += f.stats.rasterTests;
             s.rasterMs += f.stats.rasterMs;
+            s.pyramidBuilds += f.stats.pyramidBuilds;
             s.largestRegion = std::max(s.largestRegion, f.image.largestRegion);
             s.timeouts += f.stats.queriesTimedOut;
             const double framePixels = std::max(1.0, double(r.width) * double(r.height));
@@ -128,7 +129,7 @@ std::vector<ModeSummary> summarise(const BenchResult& r) {
         for (double* v : {&s.traversalMs, &s.queryMs, &s.waitMs, &s.drawMs, &s.parts, &s.triangles, &s.queries, &s.occluded,
                           &s.skippedHistory, &s.skippedOccupancy, &s.batches, &s.pctWrongMean, &s.falsePositives, &s.fpQueried,
                           &s.fpHistory, &s.fpOccupancy, &s.fpOther, &s.drawQueries, &s.drawQueriesOccluded, &s.depthTests,
-                          &s.depthReadMs, &s.rasterTests, &s.rasterMs, &s.claimedPctMean, &s.popIn})
+                          &s.depthReadMs, &s.rasterTests, &s.rasterMs, &s.pyramidBuilds, &s.claimedPctMean, &s.popIn})
             *v /= n;
         std::sort(ms.begin(), ms.end());
         s.msMin = ms.front();
@@ -196,7 +197,7 @@ const char* frameStatsCsvHeader() {
            "nodes_visited,batches,parts,triangles,query_triangles,draw_queries,draw_queries_occluded,draw_queries_late,"
            "depth_tests,ms_depth_read,raster_tests,raster_batches,ms_raster,triangle_tests,ms_triangle_test,draw_marks_hidden,"
            "cluster_tests,clusters_culled,cluster_triangles_culled,clusters_deferred,deferred_clusters_drawn,ms_clusters,budget_culled,claimed_error_pixels,claim_unbounded,"
-           "early_triangles,tested_triangles";
+           "early_triangles,tested_triangles,pyramid_builds";
 }
 
 void writeFrameStatsCsv(std::ostream& f, const FrameStats& s) {
@@ -209,7 +210,7 @@ void writeFrameStatsCsv(std::ostream& f, const FrameStats& s) {
       << s.rasterTests << ',' << s.rasterBatches << ',' << s.rasterMs << ',' << s.triangleTests << ','
       << s.triangleTestMs << ',' << s.drawMarksHidden << ',' << s.clusterTests << ',' << s.clustersCulled << ','
       << s.clusterTrianglesCulled << ',' << s.clustersDeferred << ',' << s.deferredClustersDrawn << ',' << s.clusterMs << ',' << s.budgetCulled << ',' << s.claimedErrorPixels << ','
-      << (s.claimUnbounded ? 1 : 0) << ',' << s.earlyTriangles << ',' << s.testedTriangles;
+      << (s.claimUnbounded ? 1 : 0) << ',' << s.earlyTriangles << ',' << s.testedTriangles << ',' << s.pyramidBuilds;
 }
 
 Status writeFramesCsv(const BenchResult& r, const fs::path& path) {
@@ -262,7 +263,7 @@ Status writeSummaryCsv(const std::vector<ModeSummary>& summary, const fs::path& 
          "leaf_surface_area,leaf_triangles_mean,leaf_triangles_max,paired_vs_best,false_positives_queried,"
          "false_positives_history,false_positives_occupancy,false_positives_other,draw_queries,draw_queries_occluded,"
          "depth_tests,ms_depth_read,raster_tests,ms_raster,claimed_error_pct_mean,claimed_error_pct_max,"
-         "pixels_lost_pct_max,frames_over_claim_truth,frames_over_claim_image,frames_unbounded,pixels_tied,pop_in_per_frame\n";
+         "pixels_lost_pct_max,frames_over_claim_truth,frames_over_claim_image,frames_unbounded,pixels_tied,pop_in_per_frame,pyramid_builds\n";
     for (const ModeSummary& s : summary)
         f << s.name << ',' << s.frames << ',' << s.msMean << ',' << s.msMedian << ',' << s.msMin << ',' << s.msMax
           << ',' << s.traversalMs << ',' << s.queryMs << ',' << s.waitMs << ',' << s.drawMs << ',' << s.ratioVfc << ',' << s.ratioOracle
@@ -276,7 +277,7 @@ Status writeSummaryCsv(const std::vector<ModeSummary>& summary, const fs::path& 
           << s.fpOccupancy << ',' << s.fpOther << ',' << s.drawQueries << ',' << s.drawQueriesOccluded << ','
           << s.depthTests << ',' << s.depthReadMs << ',' << s.rasterTests << ',' << s.rasterMs << ',' << s.claimedPctMean
           << ',' << s.claimedPctMax << ',' << s.lostPctMax << ',' << s.framesOverClaimTruth << ',' << s.framesOverClaimImage
-          << ',' << s.framesUnbounded << ',' << s.tiedPixels << ',' << s.popIn << '\n';
+          << ',' << s.framesUnbounded << ',' << s.tiedPixels << ',' << s.popIn << ',' << s.pyramidBuilds << '\n';
     return closeChecked(f, path);
 }
 
@@ -454,6 +455,25 @@ void writeVolumeTable(std::ofstream& f, const std::vector<ModeSummary>& summary)
          "kind (auto picks per part).\n";
 }
 
+/// The cheap tests of the modes that make them (two-phase's depth pyramid and batched raster test).
+void writeCheapTestTable(std::ostream& f, const std::vector<ModeSummary>& summary) {
+    if (std::none_of(summary.begin(), summary.end(), [](const ModeSummary& s) { return s.depthTests + s.rasterTests > 0; }))
+        return;
+    f << "\n## Cheap tests\n\n"
+      << "| mode | pyramid builds | pyramid tests | raster tests | readback + pyramid ms | raster ms | µs per test |\n"
+      << "|---|--:|--:|--:|--:|--:|--:|\n";
+    for (const ModeSummary& s : summary) {
+        const double tests = s.depthTests + s.rasterTests;
+        if (tests <= 0) continue;
+        f << "| " << s.name << " | " << fmt(s.pyramidBuilds, 2) << " | " << fmt(s.depthTests, 1) << " | " << fmt(s.rasterTests, 1)
+          << " | " << fmt(s.depthReadMs, 2) << " | " << fmt(s.rasterMs, 2) << " | "
+          << fmt(1000.0 * (s.depthReadMs + s.rasterMs) / tests, 2) << " |\n";
+    }
+    f << "\nPer frame. *Readback + pyramid ms*: reading the depth back (which waits for the drawing before it) and "
+         "building the pyramid; *raster ms*: the batched raster tests, drawn and read back; *µs per test*: both over "
+         "the pyramid and raster tests, so it counts the waits too.\n";
+}
+
 void writeFalsePositiveTable(std::ostream& f, const BenchResult& r, const std::vector<ModeSummary>& summary) {
     double visibleTris = 0, aabbParts = 0, aabbTris = 0, autoParts = 0, autoTris = 0, visibleParts = 0;
     double clusterTris = 0, visibleClusterTris = 0, hiddenClusters = 0, hiddenTris = 0, hiddenSamples = 0, budgetTris = 0, budgetPixels = 0;
@@ -578,6 +598,7 @@ Status writeReport(const BenchResult& r, const std::vector<ModeSummary>& summary
          "with no visible pixel; the largest wrong region is the biggest 4-connected blob of wrong pixels in any "
          "frame. `*` marks modes on the speed-accuracy Pareto front (the oracle is a bound, not a mode).\n";
     writeFalsePositiveTable(f, r, summary);
+    writeCheapTestTable(f, summary);
     writeClaimTable(f, summary);
     if (reportsVolumes(r)) writeVolumeTable(f, summary);
     if (!plots.empty()) {

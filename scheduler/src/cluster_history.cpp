@@ -107,6 +107,7 @@ void QueryScheduler::recordClusterVisibility(Frame& f) {
     int w = 0, h = 0;
     const bool haveDepth = f.backend.readDepth(depth_, w, h) && w == f.view.width && h == f.view.height;
     if (haveDepth) pyramid_.build(depth_, w, h);
+    f.stats.pyramidBuilds += haveDepth;
     pyramidView_.reset();
     if (haveDepth) pyramidView_ = f.view;
     f.stats.depthReadMs += msSince(t0);

@@ -73,6 +73,7 @@ void QueryScheduler::runTwoPhase(Frame& f) {
         int w = 0, hgt = 0;
         haveDepth = f.backend.readDepth(depth_, w, hgt) && w == f.view.width && hgt == f.view.height;
         if (haveDepth) pyramid_.build(depth_, w, hgt);
+        f.stats.pyramidBuilds += haveDepth;
         pyramidView_.reset();
         if (haveDepth) pyramidView_ = f.view;
         f.clusterPyramid = haveDepth;  // the late pass's draws test their clusters against it too

@@ -996,7 +996,8 @@ TEST(TwoPhaseCosts, TestsStopWhereTheyCullNothingAndResumeWhenTheyWould) {
     for (std::uint32_t f = 1; f <= 20; ++f) {
         RecordingSink sink;
         const int before = backend.reads;
-        sched.cullFrame(tree, frontCamera(), 640, 320, backend, sink);
+        const FrameStats st = sched.cullFrame(tree, frontCamera(), 640, 320, backend, sink);
+        EXPECT_EQ(st.pyramidBuilds, static_cast<std::uint32_t>(backend.reads - before)) << "a pyramid from every depth read";
         if (backend.reads > before) testedFrames.push_back(f);
         EXPECT_EQ(sink.drawn, reference) << "frame " << f;
     }

@@ -15,6 +15,7 @@ struct FrameStats {
     std::uint32_t queriesIssued = 0;
     std::uint32_t depthTests = 0;    ///< two-phase: nodes tested against the depth pyramid
     double depthReadMs = 0.0;        ///< two-phase: reading the depth back (waits for the early pass) and building the pyramid
+    std::uint32_t pyramidBuilds = 0;  ///< two-phase: depth pyramids built (each from a depth readback)
     std::uint32_t rasterTests = 0;    ///< two-phase: volumes in batched raster tests (QueryBackend::testVolumes)
     std::uint32_t rasterBatches = 0;  ///< two-phase: batched raster tests issued
     double rasterMs = 0.0;            ///< two-phase: building, drawing and waiting for the batched raster tests
