@@ -104,14 +104,7 @@ void QueryScheduler::recordClusterVisibility(Frame& f) {
     // The final depth holds every occluder the frame drew, so it hides the most clusters;
     // what it says only chooses next frame's early draws.
     const auto t0 = SchedulerClock::now();
-    int w = 0, h = 0;
-    const bool haveDepth = f.backend.readDepth(depth_, w, h) && w == f.view.width && h == f.view.height;
-    if (haveDepth) pyramid_.build(depth_, w, h);
-    f.stats.pyramidBuilds += haveDepth;
-    pyramidView_.reset();
-    if (haveDepth) pyramidView_ = f.view;
-    f.stats.depthReadMs += msSince(t0);
-    if (!haveDepth) return;  // the bits stay as they were
+    if (!buildPyramid(f)) return;  // the bits stay as they were
     const auto t1 = SchedulerClock::now();
     const SceneObjects& objs = f.objects;
     for (const NodeRef ref : clusterParts_) {

@@ -69,15 +69,8 @@ void QueryScheduler::runTwoPhase(Frame& f) {
     culledTriangles_ = 0;
     bool haveDepth = false;
     if (testing) {
-        const auto t0 = SchedulerClock::now();
-        int w = 0, hgt = 0;
-        haveDepth = f.backend.readDepth(depth_, w, hgt) && w == f.view.width && hgt == f.view.height;
-        if (haveDepth) pyramid_.build(depth_, w, hgt);
-        f.stats.pyramidBuilds += haveDepth;
-        pyramidView_.reset();
-        if (haveDepth) pyramidView_ = f.view;
+        haveDepth = buildPyramid(f);
         f.clusterPyramid = haveDepth;  // the late pass's draws test their clusters against it too
-        f.stats.depthReadMs += msSince(t0);
     }
     // The early parts' deferred clusters depend only on this pyramid: a worker selects
     // them while the late pass traverses and draws.
@@ -117,6 +110,18 @@ void QueryScheduler::runTwoPhase(Frame& f) {
         lastTestedFrame_ = f.index;
         savedNs_ = double(culledTriangles_) * params_.tuning.costs.drawNsPerTriangle;
     }
+}
+
+bool QueryScheduler::buildPyramid(Frame& f) {
+    const auto t0 = SchedulerClock::now();
+    int w = 0, h = 0;
+    const bool haveDepth = f.backend.readDepth(depth_, w, h) && w == f.view.width && h == f.view.height;
+    if (haveDepth) pyramid_.build(depth_, w, h);
+    f.stats.pyramidBuilds += haveDepth;
+    pyramidView_.reset();
+    if (haveDepth) pyramidView_ = f.view;
+    f.stats.depthReadMs += msSince(t0);
+    return haveDepth;
 }
 
 bool QueryScheduler::drawEarlySet(Frame& f) {

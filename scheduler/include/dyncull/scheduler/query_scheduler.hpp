@@ -451,6 +451,10 @@ private:
     std::vector<QueryResult> triangleAnswers_;
     /// The early pass: last frame's visible parts drawn, frustum-culled; true if any was.
     bool drawEarlySet(Frame& f);
+    /// Reads the frame's depth back and builds pyramid_ from it (counted and timed in the
+    /// frame's stats; pyramidView_ follows). False if the backend cannot read it at the
+    /// frame's size: pyramidView_ is cleared, and nothing may be tested against pyramid_.
+    bool buildPyramid(Frame& f);
     /// The late pass: every node tested against the pyramid (if `haveDepth`), the parts it
     /// lets through collected for the raster test (if this frame is `testing`) or drawn.
     void lateTraversal(Frame& f, bool testing, bool haveDepth, bool triangles);
