@@ -368,9 +368,8 @@ Status StreamedObjects::readLeaf(std::uint32_t leaf, Mesh& out) const {
         s_->truthFile.emplace(file.take());
     }
     // What the draws show: the leaf through its compact form.
-    if (Status st = s_->truthFile->read(leaf, out, s_->truthScratch); !st) return st;
     CompactLeaf compact;
-    compactLeaf(out, s_->model.leaves[leaf].box, compact);
+    if (Status st = s_->truthFile->readCompact(leaf, compact, out, s_->truthScratch); !st) return st;
     expandLeaf(compact, out);
     return {};
 }

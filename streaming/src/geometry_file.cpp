@@ -9,6 +9,7 @@
 #include <cstring>
 
 #include "dyncull/objects/checksum.hpp"
+#include "dyncull/streaming/compact_leaf.hpp"
 #include "geometry_chunk.hpp"
 
 namespace dyncull {
@@ -167,6 +168,13 @@ Status GeometryFile::read(std::uint32_t leafIndex, Mesh& out, std::vector<unsign
             return bad("vertex " + std::to_string(i) + " outside the leaf's box (or not finite)");
         if (!std::isfinite(n.x) || !std::isfinite(n.y) || !std::isfinite(n.z)) return bad("non-finite normal");
     }
+    return {};
+}
+
+Status GeometryFile::readCompact(std::uint32_t leafIndex, CompactLeaf& out, Mesh& decoded,
+                                 std::vector<unsigned char>& scratch) const {
+    if (Status st = read(leafIndex, decoded, scratch); !st) return st;
+    compactLeaf(decoded, s_->leaves[leafIndex].box, out);
     return {};
 }
 

@@ -92,8 +92,7 @@ struct LeafCache::State {
         {
             Mesh decoded;
             std::vector<unsigned char> scratch;
-            st = file.read(leaf, decoded, scratch);
-            if (st) compactLeaf(decoded, leaves[leaf].box, *compact);
+            st = file.readCompact(leaf, *compact, decoded, scratch);
         }
         lock.lock();
         entries[leaf].loading = false;

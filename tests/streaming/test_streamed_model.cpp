@@ -342,9 +342,11 @@ protected:
         std::vector<unsigned char> scratch;
         for (std::uint32_t i = 0; i < model_.leaves.size(); ++i) {
             Mesh g;
-            ASSERT_TRUE(file->read(i, g, scratch).ok());
             CompactLeaf c;  // the cache keeps leaves compact
-            compactLeaf(g, model_.leaves[i].box, c);
+            ASSERT_TRUE(file->readCompact(i, c, g, scratch).ok());
+            CompactLeaf again;  // the same as the leaf read in full and then compacted
+            compactLeaf(g, model_.leaves[i].box, again);
+            ASSERT_EQ(c.words, again.words);
             ASSERT_EQ(c.bytes(), compactLeafBytes(model_.leaves[i]));
             total_ += c.bytes();
             largest_ = std::max(largest_, c.bytes());

@@ -122,6 +122,8 @@ Expected<StreamedModel> readStreamedModel(const std::filesystem::path& nodePath)
 
 /// Reads leaves from a model's geometry file. Thread-safe: reads are positioned (pread),
 /// so a loader thread and the render thread may read at once.
+struct CompactLeaf;
+
 class GeometryFile {
 public:
     /// Opens model.geometryPath (borrowing nothing: the leaf table is copied).
@@ -135,6 +137,10 @@ public:
     /// error names the file and the leaf. `scratch` holds the raw chunk between calls.
     /// `out` gets positions, unit normals and indices (model space; its name is left alone).
     Status read(std::uint32_t leaf, Mesh& out, std::vector<unsigned char>& scratch) const;
+    /// Reads leaf `leaf` as every reader that shows it takes it (compact_leaf.hpp): checked
+    /// by read() into `decoded`, then quantised in the leaf's box into `out`. `decoded` and
+    /// `scratch` are the caller's to reuse.
+    Status readCompact(std::uint32_t leaf, CompactLeaf& out, Mesh& decoded, std::vector<unsigned char>& scratch) const;
     std::uint32_t leafCount() const;
 
 private:
