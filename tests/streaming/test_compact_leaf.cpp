@@ -99,6 +99,17 @@ TEST(CompactLeaf, MoreThan65536VerticesTakeWideIndices) {
     expectFaithful(small, box);
 }
 
+// Counts from the node file near 2^32: the byte count is exact in 64 bits, wide indices included.
+TEST(CompactLeaf, ByteCountsOfCountsNear2To32) {
+    StreamedLeaf leaf;
+    leaf.vertexCount = 0xffffffffu;
+    leaf.triangleCount = 0xffffffffu;
+    EXPECT_EQ(compactLeafBytes(leaf), (std::uint64_t{0xffffffffu} * 5 + std::uint64_t{0xffffffffu} * 6) * 2);
+    leaf.vertexCount = 0x10000;  // the last count with narrow indices
+    leaf.triangleCount = 1;
+    EXPECT_EQ(compactLeafBytes(leaf), (std::size_t{0x10000} * 5 + 3) * 2);
+}
+
 TEST(CompactLeaf, PositionsOutsideTheBoxAreClampedIntoIt) {
     const Aabb box = Aabb::fromMinMax({0.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 1.0f});
     Mesh m;
