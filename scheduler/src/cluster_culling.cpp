@@ -20,14 +20,14 @@ namespace {
 /// outside the frustum (if `frustum`: its part crosses it), or behind the depth pyramid (if
 /// `pyramid`). A cluster the eye is inside of or that reaches the near plane is visible
 /// (boxDepth says so); one off screen is not.
-bool clusterHidden(const QueryScheduler::Frame& f, const DepthPyramid* pyramid, const glm::mat4& matrix, const ObjectProjection& object,
-                   const LeafCluster& c, bool frustum) {
+bool clusterHidden(const QueryScheduler::Frame& f, const DepthPyramid* pyramid, int span, const glm::mat4& matrix,
+                   const ObjectProjection& object, const LeafCluster& c, bool frustum) {
     if (frustum && f.frustum().outside(transformAabb(matrix, c.box))) return true;
     if (!pyramid) return false;
     DepthFootprint fp;
     if (!f.screen.boxDepth(object, c.box, fp)) return false;
     // A pyramid exists only for a single-sample target: a cluster covering no pixel centre draws nothing.
-    return fp.centres.empty() || pyramid->occluded(fp.centres, fp.nearest);
+    return fp.centres.empty() || pyramid->occluded(fp.centres, fp.nearest, span);
 }
 }  // namespace
 
@@ -124,7 +124,7 @@ void QueryScheduler::selectClusters(const Frame& f, const ClusterJob& job, Clust
         const bool otherPass = job.split && clusterBit(job.shown, firstCluster + i) == (pass == ClusterPass::Deferred);
         const bool drawnEarly = pass == ClusterPass::Deferred && otherPass;
         bool culled = !drawnEarly && job.cones && job.eye.backFacing(c);
-        if (!drawnEarly && !culled && (job.frustum || pyramid)) culled = clusterHidden(f, pyramid, job.matrix, job.object, c, job.frustum);
+        if (!drawnEarly && !culled && (job.frustum || pyramid)) culled = clusterHidden(f, pyramid, params_.tuning.clusterPyramidSpan, job.matrix, job.object, c, job.frustum);
         if (culled) {
             ++out.culledClusters;
             out.culledTriangles += c.indexCount / 3;

@@ -385,8 +385,12 @@ TEST(QueryScheduler, ParamsAreValidated) {
         p = {};
         p.tuning.pyramidSpan = span;
         EXPECT_FALSE(validateSchedulerParams(p).ok()) << span;
+        p = {};
+        p.tuning.clusterPyramidSpan = span;
+        EXPECT_FALSE(validateSchedulerParams(p).ok()) << span;
     }
     p.tuning.pyramidSpan = 64;
+    p.tuning.clusterPyramidSpan = 2;
     EXPECT_TRUE(validateSchedulerParams(p).ok());
     EXPECT_FALSE(parseCullMode("fast").ok());
     EXPECT_EQ(parseCullMode("full").value(), CullMode::TwoPhase);
