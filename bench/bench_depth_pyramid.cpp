@@ -1,12 +1,20 @@
 // The CPU depth pyramid: building it from a 640x360 depth buffer, and testing screen
 // rectangles of the sizes the swarm's parts project to (4 to 64 pixels a side) against it.
-// Items per second of BM_DepthPyramidTest is rectangles tested per second.
+// Items per second of BM_DepthPyramidTest is rectangles tested per second. BM_ClusterTest
+// is one cluster's whole test as the late pass runs it (cluster_culling.cpp): the normal
+// cone, the box's footprint (ScreenProjection::boxCentres) and the pyramid at span 32, on
+// boxes of 1 to 40 pixels seen through a rotated and scaled object matrix; its parts alone
+// are BM_ClusterCone and BM_ClusterFootprint.
 #include <benchmark/benchmark.h>
 
 #include <random>
 #include <vector>
 
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "dyncull/bsp/leaf_clusters.hpp"
 #include "dyncull/scheduler/depth_pyramid.hpp"
+#include "screen_projection.hpp"
 
 namespace {
 
@@ -53,6 +61,75 @@ void BM_DepthPyramidTest(benchmark::State& state) {
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * static_cast<std::int64_t>(rects.size()));
 }
 BENCHMARK(BM_DepthPyramidTest);
+
+struct ClusterScene {
+    Camera camera;
+    FrameView view;
+    glm::mat4 matrix{1.0f};
+    std::vector<LeafCluster> clusters;
+    DepthPyramid pyramid;
+
+    ClusterScene() {
+        camera.position = {0.3f, 0.2f, 8.0f};
+        camera.target = {0.0f, 0.0f, 0.0f};
+        view = FrameView::of(camera, 640, 360);
+        matrix = glm::scale(glm::rotate(glm::mat4(1.0f), 0.6f, glm::normalize(glm::vec3(1.0f, 2.0f, 0.5f))), glm::vec3(1.5f));
+        std::mt19937 rng(9);
+        std::uniform_real_distribution<float> u(-2.0f, 2.0f), size(0.01f, 0.3f), d(-1.0f, 1.0f);
+        clusters.resize(4096);
+        for (LeafCluster& c : clusters) {
+            const glm::vec3 lo(u(rng), u(rng), u(rng));
+            c.box = Aabb::fromMinMax(lo, lo + glm::vec3(size(rng), size(rng), size(rng)));
+            c.coneApex = c.box.center();
+            c.coneAxis = glm::normalize(glm::vec3(d(rng), d(rng), d(rng)) + glm::vec3(0.0f, 0.0f, 0.01f));
+            c.coneCutoff = 0.3f;
+        }
+        const std::vector<float> depth = depthBuffer(640, 360);
+        pyramid.build(depth, 640, 360);
+    }
+};
+
+void BM_ClusterCone(benchmark::State& state) {
+    const ClusterScene s;
+    const ObjectSpaceEye eye(s.camera, s.matrix);
+    std::size_t culled = 0;
+    for (auto _ : state)
+        for (const LeafCluster& c : s.clusters) culled += eye.backFacing(c);
+    benchmark::DoNotOptimize(culled);
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * static_cast<std::int64_t>(s.clusters.size()));
+}
+BENCHMARK(BM_ClusterCone);
+
+void BM_ClusterFootprint(benchmark::State& state) {
+    const ClusterScene s;
+    const ScreenProjection screen(s.view);
+    const ObjectProjection object = screen.objectProjection(s.matrix);
+    std::size_t inFront = 0;
+    ScreenRect centres;
+    float nearest = 0.0f;
+    for (auto _ : state)
+        for (const LeafCluster& c : s.clusters) inFront += screen.boxCentres(object, c.box, centres, nearest);
+    benchmark::DoNotOptimize(inFront);
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * static_cast<std::int64_t>(s.clusters.size()));
+}
+BENCHMARK(BM_ClusterFootprint);
+
+void BM_ClusterTest(benchmark::State& state) {
+    const ClusterScene s;
+    const ScreenProjection screen(s.view);
+    const ObjectProjection object = screen.objectProjection(s.matrix);
+    const ObjectSpaceEye eye(s.camera, s.matrix);
+    std::size_t culled = 0;
+    ScreenRect centres;
+    float nearest = 0.0f;
+    for (auto _ : state)
+        for (const LeafCluster& c : s.clusters)
+            culled += eye.backFacing(c) ||
+                      (screen.boxCentres(object, c.box, centres, nearest) && (centres.empty() || s.pyramid.occluded(centres, nearest, 32)));
+    benchmark::DoNotOptimize(culled);
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * static_cast<std::int64_t>(s.clusters.size()));
+}
+BENCHMARK(BM_ClusterTest);
 
 }  // namespace
 

@@ -24,10 +24,11 @@ bool clusterHidden(const QueryScheduler::Frame& f, const DepthPyramid* pyramid, 
                    const ObjectProjection& object, const LeafCluster& c, bool frustum) {
     if (frustum && f.frustum().outside(transformAabb(matrix, c.box))) return true;
     if (!pyramid) return false;
-    DepthFootprint fp;
-    if (!f.screen.boxDepth(object, c.box, fp)) return false;
+    ScreenRect centres;
+    float nearest = 0.0f;
+    if (!f.screen.boxCentres(object, c.box, centres, nearest)) return false;
     // A pyramid exists only for a single-sample target: a cluster covering no pixel centre draws nothing.
-    return fp.centres.empty() || pyramid->occluded(fp.centres, fp.nearest, span);
+    return centres.empty() || pyramid->occluded(centres, nearest, span);
 }
 }  // namespace
 

@@ -64,13 +64,29 @@ bool ScreenProjection::rect(const Aabb& box, ScreenRect& out) const {
     return !crosses;
 }
 
+namespace {
+// floor and ceil of v, clamped to [lo, hi]: v is clamped first, so that the conversion is
+// exact and the rounding one comparison (without SSE4.1 std::floor is a library call, and
+// these run twice per cluster, tens of thousands of times a frame).
+int floorIn(double v, int lo, int hi) {
+    const double c = std::clamp(v, double(lo) - 1.0, double(hi) + 1.0);
+    const int t = static_cast<int>(c);  // towards zero
+    return std::clamp(t - (c < double(t) ? 1 : 0), lo, hi);
+}
+int ceilIn(double v, int lo, int hi) {
+    const double c = std::clamp(v, double(lo) - 1.0, double(hi) + 1.0);
+    const int t = static_cast<int>(c);
+    return std::clamp(t + (c > double(t) ? 1 : 0), lo, hi);
+}
+}  // namespace
+
 ScreenRect ScreenProjection::pixelRect(const glm::dvec2& lo, const glm::dvec2& hi) const {
     // Pixels, rounded outwards and padded by one so rasterisation rules never leave a
     // covered pixel outside the rectangle.
     const double fx = 0.5 * view_.width, fy = 0.5 * view_.height;
-    auto clampi = [](double v, int lim) { return static_cast<int>(std::clamp(v, 0.0, static_cast<double>(lim))); };
-    return {clampi(std::floor((lo.x + 1.0) * fx) - 1.0, view_.width), clampi(std::floor((lo.y + 1.0) * fy) - 1.0, view_.height),
-            clampi(std::ceil((hi.x + 1.0) * fx) + 1.0, view_.width), clampi(std::ceil((hi.y + 1.0) * fy) + 1.0, view_.height)};
+    const int w = view_.width, h = view_.height;
+    return {floorIn((lo.x + 1.0) * fx, 1, w + 1) - 1, floorIn((lo.y + 1.0) * fy, 1, h + 1) - 1,
+            ceilIn((hi.x + 1.0) * fx, -1, w - 1) + 1, ceilIn((hi.y + 1.0) * fy, -1, h - 1) + 1};
 }
 
 ScreenRect ScreenProjection::centreRect(const glm::dvec2& lo, const glm::dvec2& hi) const {
@@ -78,10 +94,9 @@ ScreenRect ScreenProjection::centreRect(const glm::dvec2& lo, const glm::dvec2& 
     // to its sub-pixel grid, at least 4 bits in GL (SUBPIXEL_BITS), so by at most 1/32 pixel.
     constexpr double kSnap = 1.0 / 16.0;
     const double fx = 0.5 * view_.width, fy = 0.5 * view_.height;
-    auto clampi = [](double v, int lim) { return static_cast<int>(std::clamp(v, 0.0, static_cast<double>(lim))); };
-    return {clampi(std::ceil((lo.x + 1.0) * fx - 0.5 - kSnap), view_.width), clampi(std::ceil((lo.y + 1.0) * fy - 0.5 - kSnap), view_.height),
-            clampi(std::floor((hi.x + 1.0) * fx - 0.5 + kSnap) + 1.0, view_.width),
-            clampi(std::floor((hi.y + 1.0) * fy - 0.5 + kSnap) + 1.0, view_.height)};
+    const int w = view_.width, h = view_.height;
+    return {ceilIn((lo.x + 1.0) * fx - 0.5 - kSnap, 0, w), ceilIn((lo.y + 1.0) * fy - 0.5 - kSnap, 0, h),
+            floorIn((hi.x + 1.0) * fx - 0.5 + kSnap, -1, w - 1) + 1, floorIn((hi.y + 1.0) * fy - 0.5 + kSnap, -1, h - 1) + 1};
 }
 
 glm::mat4 ScreenProjection::clipMatrixOf(const glm::mat4& matrix) const {
@@ -128,7 +143,8 @@ ObjectProjection ScreenProjection::objectProjection(const glm::mat4& matrix) con
     return p;
 }
 
-bool ScreenProjection::boxDepth(const ObjectProjection& object, const Aabb& local, DepthFootprint& out) const {
+ScreenProjection::BoxNdc ScreenProjection::boxNdc(const ObjectProjection& object, const Aabb& local, glm::dvec2& ndcLo, glm::dvec2& ndcHi,
+                                                  double& nearestDepth) const {
     // QueryVolume::enlargedForRounding for a box: its vertices' magnitude sets the margin,
     // and each face is pushed out by it through a scale about the centre by k.
     const glm::dvec3 lo(local.min), hi(local.max);
@@ -141,15 +157,75 @@ bool ScreenProjection::boxDepth(const ObjectProjection& object, const Aabb& loca
     const double magnitude = std::max({reach.x, reach.y, reach.z});  // of the farthest corner, per coordinate
     const double push = magnitude * 0x1p-22 * std::sqrt(3.0);
     const double nearest = std::min({half.x * object.faceScale.x, half.y * object.faceScale.y, half.z * object.faceScale.z});
-    if (!(nearest > 4.0 * push))  // thin: as a box of boxes; the float matrix is toWorld rounded back, exactly
-        return volumeDepth(QueryVolume::fromTransformedBox(glm::mat4(object.toWorld), local), out);
+    if (!(nearest > 4.0 * push)) return BoxNdc::Thin;
     const double k = 1.0 + push / nearest;
+    // The corners are the centre plus or minus each scaled axis, and the projection is
+    // linear: the centre and the three axes are projected once, the corners summed in clip
+    // space (what pointsDepth does per corner, in a third of the arithmetic).
     const glm::dvec3 relCentre = worldCentre - glm::dvec3(view_.camera.position);
-    std::array<glm::dvec3, 8> rel;
-    for (int i = 0; i < 8; ++i)
-        rel[static_cast<std::size_t>(i)] =
-            relCentre + k * ((i & 1) ? axis[0] : -axis[0]) + k * ((i & 2) ? axis[1] : -axis[1]) + k * ((i & 4) ? axis[2] : -axis[2]);
-    return pointsDepth(rel.data(), 8, out);
+    const glm::dvec3 a0 = k * axis[0], a1 = k * axis[1], a2 = k * axis[2];
+    const glm::dvec3 spread = glm::abs(a0) + glm::abs(a1) + glm::abs(a2);
+    // The largest coordinate of any corner: per axis the centre's plus the spread, exactly
+    // as the corners' (the sign pattern that reaches it is one of the eight).
+    const glm::dvec3 far = glm::abs(relCentre) + spread;
+    const double nearPlane = double(view_.camera.nearPlane);
+    const double nearTest = nearPlane + 0x1p-21 * std::max({far.x, far.y, far.z}) + 0x1p-22 * nearPlane;
+    const glm::dmat4& m = view_.viewProjRelative;
+    const glm::dvec4 c = m * glm::dvec4(relCentre, 1.0);
+    const glm::dvec4 p0 = m * glm::dvec4(a0, 0.0), p1 = m * glm::dvec4(a1, 0.0), p2 = m * glm::dvec4(a2, 0.0);
+    const bool ortho = view_.camera.orthographic();
+    const double dc = ortho ? glm::dot(distanceRow_, glm::dvec4(relCentre, 1.0)) : c.w;
+    const double d0 = ortho ? glm::dot(distanceRow_, glm::dvec4(a0, 0.0)) : p0.w;
+    const double d1 = ortho ? glm::dot(distanceRow_, glm::dvec4(a1, 0.0)) : p1.w;
+    const double d2 = ortho ? glm::dot(distanceRow_, glm::dvec4(a2, 0.0)) : p2.w;
+    // The nearest corner along the view decides the near test for all eight.
+    if (dc - std::abs(d0) - std::abs(d1) - std::abs(d2) < nearTest) return BoxNdc::Crossing;
+    ndcLo = glm::dvec2(1e300);
+    ndcHi = glm::dvec2(-1e300);
+    nearestDepth = 0.0;
+    for (int i = 0; i < 8; ++i) {
+        const glm::dvec4 clip = c + ((i & 1) ? p0 : -p0) + ((i & 2) ? p1 : -p1) + ((i & 4) ? p2 : -p2);
+        const double inv = 1.0 / clip.w;
+        const glm::dvec2 ndc = glm::dvec2(clip) * inv;
+        ndcLo = glm::min(ndcLo, ndc);
+        ndcHi = glm::max(ndcHi, ndc);
+        nearestDepth = std::max(nearestDepth, clip.z * inv);
+    }
+    return BoxNdc::InFront;
+}
+
+bool ScreenProjection::boxDepth(const ObjectProjection& object, const Aabb& local, DepthFootprint& out) const {
+    glm::dvec2 lo, hi;
+    double nearest = 0.0;
+    switch (boxNdc(object, local, lo, hi, nearest)) {
+    case BoxNdc::Crossing: return false;
+    case BoxNdc::Thin:  // as a box of boxes; the float matrix is toWorld rounded back, exactly
+        return volumeDepth(QueryVolume::fromTransformedBox(glm::mat4(object.toWorld), local), out);
+    case BoxNdc::InFront: break;
+    }
+    out.rect = pixelRect(lo, hi);
+    out.centres = centreRect(lo, hi);
+    out.nearest = static_cast<float>(nearest);
+    return true;
+}
+
+bool ScreenProjection::boxCentres(const ObjectProjection& object, const Aabb& local, ScreenRect& centres, float& nearestDepth) const {
+    glm::dvec2 lo, hi;
+    double nearest = 0.0;
+    switch (boxNdc(object, local, lo, hi, nearest)) {
+    case BoxNdc::Crossing: return false;
+    case BoxNdc::Thin: {
+        DepthFootprint fp;
+        if (!volumeDepth(QueryVolume::fromTransformedBox(glm::mat4(object.toWorld), local), fp)) return false;
+        centres = fp.centres;
+        nearestDepth = fp.nearest;
+        return true;
+    }
+    case BoxNdc::InFront: break;
+    }
+    centres = centreRect(lo, hi);
+    nearestDepth = static_cast<float>(nearest);
+    return true;
 }
 
 bool ScreenProjection::pointsDepth(const glm::dvec3* rel, std::uint32_t n, DepthFootprint& out) const {

@@ -59,6 +59,9 @@ public:
     /// The same margins for rounding, from the exact corners instead of their float
     /// roundings; a box too thin for them goes through volumeDepth.
     bool boxDepth(const ObjectProjection& object, const Aabb& local, DepthFootprint& out) const;
+    /// boxDepth's `centres` and `nearest` alone, all a depth-pyramid test reads (the
+    /// clusters' test, by the tens of thousands a frame).
+    bool boxCentres(const ObjectProjection& object, const Aabb& local, ScreenRect& centres, float& nearestDepth) const;
     /// A guess, for choices that need no guarantee (cluster history's record of what
     /// showed): the pixels whose centres box `local` under `objectToClip` (object space to
     /// clip space, camera-relative: clipMatrixOf) covers and its nearest window depth, its 8
@@ -80,6 +83,11 @@ private:
         return view_.camera.orthographic() ? glm::dot(distanceRow_, glm::dvec4(rel, 1.0)) : clip.w;
     }
 
+    enum class BoxNdc : std::uint8_t { InFront, Crossing, Thin };
+    /// boxDepth's corners in normalised device coordinates: their bounds and nearest window
+    /// depth (InFront), a box reaching the near plane (Crossing), or one too thin for the
+    /// margins of its centre-and-axes form (Thin: left to volumeDepth).
+    BoxNdc boxNdc(const ObjectProjection& object, const Aabb& local, glm::dvec2& ndcLo, glm::dvec2& ndcHi, double& nearestDepth) const;
     /// The footprint of the eye-relative points `rel[0, n)`, which already hold their margins.
     bool pointsDepth(const glm::dvec3* rel, std::uint32_t n, DepthFootprint& out) const;
 

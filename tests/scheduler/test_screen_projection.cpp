@@ -52,7 +52,12 @@ void compare(const Case& c, int& projected) {
     const bool fastInFront = screen.boxDepth(screen.objectProjection(c.matrix), c.box, fast);
     const bool referenceInFront = screen.volumeDepth(QueryVolume::fromTransformedBox(c.matrix, c.box), reference);
     ASSERT_EQ(fastInFront, referenceInFront);
+    ScreenRect centres;
+    float nearest = 0.0f;
+    ASSERT_EQ(screen.boxCentres(screen.objectProjection(c.matrix), c.box, centres, nearest), fastInFront);
     if (!fastInFront) return;
+    EXPECT_EQ(centres, fast.centres);  // the same footprint, without its outer rectangle
+    EXPECT_EQ(nearest, fast.nearest);
     ++projected;
     expectRectNear(fast.rect, reference.rect);
     expectRectNear(fast.centres, reference.centres);

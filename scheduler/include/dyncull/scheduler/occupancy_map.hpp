@@ -18,6 +18,7 @@ struct ScreenRect {
     int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
     bool empty() const { return x1 <= x0 || y1 <= y0; }
     int area() const { return empty() ? 0 : (x1 - x0) * (y1 - y0); }
+    bool operator==(const ScreenRect&) const = default;
 };
 
 class OccupancyMap {
