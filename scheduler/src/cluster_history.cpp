@@ -17,7 +17,9 @@ namespace dyncull {
 
 namespace {
 /// The record tests a cluster at the finest pyramid level its rectangle spans at most
-/// this many texels of (up to 256 reads; the late pass's tests read at most 16).
+/// this many texels of (up to 256 reads). Not the late pass's clusterPyramidSpan: at 32
+/// and 64 the record took long enough that its cost model turned it off more often, and
+/// the city drew more early triangles (docs/BENCHMARKS.md, "cluster span").
 constexpr int kRecordSpan = 16;
 }  // namespace
 
