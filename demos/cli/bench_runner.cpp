@@ -303,7 +303,7 @@ Expected<std::vector<ModeSpec>> modesFromList(const std::string& list) {
 std::string sweepParamsHelp() {
     return "pixel-threshold, max-skip, skip-per-visible, small-feature, max-in-flight, tile-size, auto-saving (percent), "
            "latency (0 or 1 frames); error-budget (full; percent of the frame's pixels, decimals allowed); pyramid-span (full; "
-           "texels a side of the late pass's pyramid tests, 2 to 64); cluster-span (full; the same for cluster tests); test-ns (full; the cost model's nanoseconds per batched volume "
+           "texels a side of the late pass's pyramid tests, 2 to 64); cluster-span (full; the same for cluster tests); candidate-rounds (full; rounds of the late pass's raster tests, 1 to 16); test-ns (full; the cost model's nanoseconds per batched volume "
            "test, TestCosts::testNsPerVolume)";
 }
 
@@ -342,6 +342,9 @@ Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec) {
         } else if (param == "pyramid-span") {
             m.scheduler.mode = CullMode::TwoPhase;
             m.scheduler.tuning.pyramidSpan = static_cast<int>(std::min<std::uint32_t>(v, 1u << 20));
+        } else if (param == "candidate-rounds") {
+            m.scheduler.mode = CullMode::TwoPhase;
+            m.scheduler.tuning.candidateRounds = v;
         } else if (param == "cluster-span") {
             m.scheduler.mode = CullMode::TwoPhase;
             m.scheduler.tuning.clusterPyramidSpan = static_cast<int>(std::min<std::uint32_t>(v, 1u << 20));

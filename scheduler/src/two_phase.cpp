@@ -238,6 +238,21 @@ void learnOccludedRate(double& rate, const std::vector<QueryResult>& answers) {
 
 void QueryScheduler::testCandidates(Frame& f, bool triangles) {
     const bool budget = params_.approx.errorBudgetPercent > 0.0;
+    const std::size_t rounds = budget ? 1 : std::min<std::size_t>(params_.tuning.candidateRounds, candidates_.size());
+    if (rounds > 1) {
+        // Front to back (the traversal's order): a later round is tested against the depth
+        // of the earlier rounds' visible parts too.
+        allCandidates_.swap(candidates_);
+        for (std::size_t r = 0; r < rounds; ++r) {
+            const std::size_t begin = allCandidates_.size() * r / rounds, end = allCandidates_.size() * (r + 1) / rounds;
+            candidates_.assign(allCandidates_.begin() + std::ptrdiff_t(begin), allCandidates_.begin() + std::ptrdiff_t(end));
+            rasterTest(f, candidates_, false);
+            budgetCulled_.assign(candidates_.size(), kBudgetNo);
+            learnOccludedRate(candidateOccludedRate_, rasterAnswers_);
+            settleCandidates(f, triangles);
+        }
+        return;
+    }
     rasterTest(f, candidates_, budget);
     budgetCulled_.assign(candidates_.size(), kBudgetNo);
     if (!budget) {

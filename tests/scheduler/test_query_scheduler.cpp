@@ -10,6 +10,7 @@
 #include <functional>
 #include <map>
 #include <set>
+#include <string>
 #include <thread>
 
 #include "dyncull/bsp/local_bsp.hpp"
@@ -389,6 +390,13 @@ TEST(QueryScheduler, ParamsAreValidated) {
         p.tuning.clusterPyramidSpan = span;
         EXPECT_FALSE(validateSchedulerParams(p).ok()) << span;
     }
+    for (const std::uint32_t rounds : {0u, 17u}) {
+        p = {};
+        p.tuning.candidateRounds = rounds;
+        EXPECT_FALSE(validateSchedulerParams(p).ok()) << rounds;
+    }
+    p = {};
+    p.tuning.candidateRounds = 16;
     p.tuning.pyramidSpan = 64;
     p.tuning.clusterPyramidSpan = 2;
     EXPECT_TRUE(validateSchedulerParams(p).ok());
@@ -982,6 +990,81 @@ SchedulerParams twoPhase() {
 }
 
 }  // namespace
+
+// With candidateRounds 2 the late pass's candidates are tested in two batches, the nearer
+// half first, and the parts the first batch finds visible are drawn before the second is
+// tested (so their depth can hide the farther half); the last round's answers still decide.
+TEST(TwoPhaseRounds, NearerCandidatesAreTestedAndDrawnBeforeTheFartherHalf) {
+    TestScene s(4, 3);  // rows at z = -3, -5, -7
+    for (const std::uint32_t rounds : {1u, 2u}) {
+        DepthBackend backend;
+        std::vector<std::string> events;
+        std::vector<float> batchNearest;  // per batch: its nearest volume's distance along -Z
+        std::vector<float> batchFarthest;
+        // The farthest row is hidden: only a test can say so.
+        backend.rule = [&](const QueryVolume& v) {
+            float zMax = -1e30f;
+            for (const glm::vec3& q : v.points()) zMax = std::max(zMax, q.z);
+            return zMax < -6.0f ? QueryResult::Occluded : QueryResult::Visible;
+        };
+        struct Sink final : PartSink {
+            std::vector<std::string>* events = nullptr;
+            std::multiset<std::uint32_t> drawn;
+            void drawPart(NodeRef part, std::uint32_t, std::uint32_t) override {
+                drawn.insert(part.object);
+                events->push_back("draw");
+            }
+        };
+        struct Logged final : QueryBackend {
+            DepthBackend* inner = nullptr;
+            std::vector<std::string>* events = nullptr;
+            std::vector<float>*nearest = nullptr, *farthest = nullptr;
+            void beginFrame(const FrameView& v) override { inner->beginFrame(v); }
+            void beginBatch() override { inner->beginBatch(); }
+            QueryId issue(const QueryVolume& v) override { return inner->issue(v); }
+            void endBatch() override {}
+            QueryResult poll(QueryId id) override { return inner->poll(id); }
+            QueryResult wait(QueryId id, double t) override { return inner->wait(id, t); }
+            void release(QueryId) override {}
+            bool readDepth(std::vector<float>& d, int& w, int& h) override { return inner->readDepth(d, w, h); }
+            BatchId testVolumes(std::span<const QueryVolume> volumes, bool count) override {
+                float lo = 1e30f, hi = -1e30f;
+                for (const QueryVolume& v : volumes)
+                    for (const glm::vec3& q : v.points()) lo = std::min(lo, -q.z), hi = std::max(hi, -q.z);
+                nearest->push_back(lo);
+                farthest->push_back(hi);
+                events->push_back("test");
+                return inner->testVolumes(volumes, count);
+            }
+            bool collectVolumes(BatchId id, std::span<QueryResult> out, double t, std::span<std::uint32_t> samples) override {
+                return inner->collectVolumes(id, out, t, samples);
+            }
+        } logged;
+        logged.inner = &backend;
+        logged.events = &events;
+        logged.nearest = &batchNearest;
+        logged.farthest = &batchFarthest;
+        SchedulerParams p = twoPhase();
+        p.features.useCostModel = false;  // every part the pyramid lets through is a candidate
+        p.tuning.candidateRounds = rounds;
+        QueryScheduler sched(p);
+        TwoLevelTree tree(s.bsp, s.objects);
+        Sink sink;
+        sink.events = &events;
+        sched.cullFrame(tree, frontCamera(), 640, 320, logged, sink);
+        // The first frame has no early set: every part is a candidate, the hidden row is not drawn.
+        EXPECT_EQ(sink.drawn.size(), 8u) << rounds;
+        // Candidate rounds, then the refresh test of the parts drawn.
+        ASSERT_EQ(batchNearest.size(), rounds + 1) << rounds;
+        if (rounds == 2) {
+            EXPECT_LE(batchFarthest[0], batchNearest[1] + 2.0f) << "the first round holds the nearer candidates";
+            EXPECT_LT(batchNearest[0], batchNearest[1]);
+            const auto firstTest = std::find(events.begin(), events.end(), "test");
+            const auto secondTest = std::find(firstTest + 1, events.end(), "test");
+            EXPECT_GT(std::count(firstTest, secondTest, "draw"), 0) << "the first round's visible parts are drawn before the second round";
+        }
+    }
+}
 
 // Where the tests cull nothing (Sponza's case), the cost model stops reading depth back
 // after the first frame and tries again every probeFrames frames; once occlusion appears,

@@ -241,6 +241,12 @@ struct SchedulerTuning {
     /// to the box's projection: 32 drew 7% fewer triangles than 4 on the power plant for 5%
     /// more cluster-test time (docs/BENCHMARKS.md, "cluster span").
     int clusterPyramidSpan = 32;
+    /// TwoPhase: the late pass's candidates are tested in this many rounds, front to back
+    /// (at least 1, at most 16): each round is tested against the depth of the rounds before
+    /// it, whose visible parts are drawn first, at the price of one more wait per round. 2
+    /// drew 4% fewer triangles than 1 on the power plant (3 no fewer than 2), 6% on the city
+    /// (docs/BENCHMARKS.md, "candidate rounds").
+    std::uint32_t candidateRounds = 2;
     TestCosts costs;
 };
 
@@ -441,6 +447,7 @@ private:
     // (testedVolume) rather than kept: a k-DOP is 860 bytes, and a frame without history
     // has tens of thousands of candidates.
     std::vector<NodeRef> candidates_, refresh_;
+    std::vector<NodeRef> allCandidates_;  // every candidate while they are tested in rounds
     /// The volume `ref` is tested with in two-phase (world space): its world box for a
     /// scene node or without tight volumes, else its own volume under its object's matrix.
     QueryVolume testedVolume(const Frame& f, NodeRef ref) const;
