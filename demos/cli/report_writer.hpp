@@ -34,6 +34,9 @@ struct ModeSummary {
     double depthTests = 0, depthReadMs = 0;           ///< per frame (full: pyramid tests, depth readback + pyramid build)
     double rasterTests = 0, rasterMs = 0;             ///< per frame (full: volumes in batched raster tests, their time)
     double pyramidBuilds = 0;                         ///< per frame (full: depth pyramids built)
+    /// Per frame, measured only by full-splitwaits (SchedulerTuning::splitDrawWaits): of
+    /// depthReadMs and rasterMs the waits for drawing, and the pyramid tests' CPU.
+    double drawWaitMs = 0, pyramidTestMs = 0;
     std::uint64_t largestRegion = 0;          ///< largest wrong region of any frame, pixels
     std::uint64_t timeouts = 0;               ///< queries that never answered, summed
     double ratioVfc = 0, ratioOracle = 0;     ///< msMean / that mode's msMean (0 if absent)

@@ -208,6 +208,8 @@ bool GlQueryBackend::readDepth(std::vector<float>& depth, int& width, int& heigh
     return true;
 }
 
+void GlQueryBackend::finishDrawing() { glFinish(); }
+
 void GlQueryBackend::beginBatch() {
     assert(!inBatch_ && !inDrawQuery_);
     inBatch_ = true;

@@ -112,8 +112,16 @@ void QueryScheduler::runTwoPhase(Frame& f) {
     }
 }
 
+void QueryScheduler::splitDrawWait(Frame& f) {
+    if (!params_.tuning.splitDrawWaits) return;
+    const auto t0 = SchedulerClock::now();
+    f.backend.finishDrawing();
+    f.stats.drawWaitMs += msSince(t0);
+}
+
 bool QueryScheduler::buildPyramid(Frame& f) {
     const auto t0 = SchedulerClock::now();
+    splitDrawWait(f);
     int w = 0, h = 0;
     const bool haveDepth = f.backend.readDepth(depth_, w, h) && w == f.view.width && h == f.view.height;
     if (haveDepth) pyramid_.build(depth_, w, h);
@@ -175,6 +183,7 @@ void QueryScheduler::lateTraversal(Frame& f, bool testing, bool haveDepth, bool 
         // Object nodes by their own volume (a transformed box or k-DOP, tighter than the
         // world box of a rotated part), scene nodes by their box; both grown by rounding.
         DepthFootprint fp;
+        const auto tTest = params_.tuning.splitDrawWaits ? SchedulerClock::now() : SchedulerClock::time_point{};
         const bool inFront = f.screen.volumeDepth(testedVolume(f, ref), fp);
         const ScreenRect& rect = fp.rect;
         bool certain = false;  // visible without any test (near plane, camera inside)
@@ -190,7 +199,9 @@ void QueryScheduler::lateTraversal(Frame& f, bool testing, bool haveDepth, bool 
             ++f.stats.depthTests;
             // The pyramid exists only for a single-sample target, where a volume that covers
             // no pixel centre draws nothing.
-            if (fp.centres.empty() || pyramid_.occluded(fp.centres, fp.nearest, params_.tuning.pyramidSpan)) {
+            const bool occluded = fp.centres.empty() || pyramid_.occluded(fp.centres, fp.nearest, params_.tuning.pyramidSpan);
+            if (params_.tuning.splitDrawWaits) f.stats.pyramidTestMs += msSince(tTest);
+            if (occluded) {
                 ++f.stats.queriesOccluded;
                 culledTriangles_ += subtreeTriangles(f, ref);
                 history_.recordAnswer(h, false, f.index);
@@ -436,6 +447,7 @@ void QueryScheduler::rasterTest(Frame& f, const std::vector<NodeRef>& parts, boo
     rasterAnswers_.assign(parts.size(), QueryResult::Visible);
     rasterSamples_.assign(countSamples ? parts.size() : 0, kUnknownSamples);
     rasterBatches_.clear();
+    splitDrawWait(f);
     for (std::size_t start = 0; start < parts.size(); start += kRasterBatchVolumes) {
         const std::size_t end = std::min(parts.size(), start + kRasterBatchVolumes);
         rasterVolumes_.clear();

@@ -949,8 +949,10 @@ struct DepthBackend final : QueryBackend {
     std::function<float(int, int)> depthAt;  // per pixel (x, y from the lower left) if set
 
     std::function<QueryResult(const QueryVolume&)> rule = [](const QueryVolume&) { return QueryResult::Visible; };
-    int reads = 0, tested = 0;
+    int reads = 0, tested = 0, batches = 0, finishes = 0;
     std::vector<std::vector<QueryResult>> answers;  // per batch, until collected
+
+    void finishDrawing() override { ++finishes; }
 
     void beginFrame(const FrameView&) override {}
     void beginBatch() override { ADD_FAILURE() << "two-phase issues no hardware query"; }
@@ -971,6 +973,7 @@ struct DepthBackend final : QueryBackend {
     }
     BatchId testVolumes(std::span<const QueryVolume> volumes, bool = false) override {
         tested += static_cast<int>(volumes.size());
+        ++batches;
         answers.emplace_back();
         for (const QueryVolume& v : volumes) answers.back().push_back(rule(v));
         return static_cast<BatchId>(answers.size() - 1);
@@ -1064,6 +1067,43 @@ TEST(TwoPhaseRounds, NearerCandidatesAreTestedAndDrawnBeforeTheFartherHalf) {
             EXPECT_GT(std::count(firstTest, secondTest, "draw"), 0) << "the first round's visible parts are drawn before the second round";
         }
     }
+}
+
+// splitDrawWaits (a measurement) waits for the drawing before every depth read and every
+// raster test and times it apart; the decisions are the same as without it.
+TEST(TwoPhaseStats, SplitDrawWaitsWaitsBeforeEveryReadAndTestAndDecidesAlike) {
+    TestScene s(4, 3);
+    std::multiset<std::uint32_t> drawn[2];
+    for (const bool split : {false, true}) {
+        DepthBackend backend;
+        backend.rule = [](const QueryVolume& v) {
+            float zMax = -1e30f;
+            for (const glm::vec3& q : v.points()) zMax = std::max(zMax, q.z);
+            return zMax < -6.0f ? QueryResult::Occluded : QueryResult::Visible;
+        };
+        SchedulerParams p = twoPhase();
+        p.features.useCostModel = false;
+        p.tuning.splitDrawWaits = split;
+        QueryScheduler sched(p);
+        TwoLevelTree tree(s.bsp, s.objects);
+        FrameStats st;
+        for (int f = 0; f < 3; ++f) {
+            RecordingSink sink;
+            st = sched.cullFrame(tree, frontCamera(), 640, 320, backend, sink);
+            drawn[split] = sink.drawn;
+        }
+        if (split) {
+            EXPECT_EQ(backend.finishes, backend.reads + backend.batches);
+            EXPECT_GT(st.depthTests, 0u);
+            EXPECT_GT(st.pyramidTestMs, 0.0);
+            EXPECT_GE(st.drawWaitMs, 0.0);
+        } else {
+            EXPECT_EQ(backend.finishes, 0);
+            EXPECT_EQ(st.drawWaitMs, 0.0);
+            EXPECT_EQ(st.pyramidTestMs, 0.0);
+        }
+    }
+    EXPECT_EQ(drawn[0], drawn[1]);
 }
 
 // Where the tests cull nothing (Sponza's case), the cost model stops reading depth back

@@ -70,6 +70,7 @@ public:
     /// false (no early depth) if no target was set or its depth cannot be read (setTarget).
     /// The read framebuffer, pixel-pack buffer and pack parameters are restored.
     bool readDepth(std::vector<float>& depth, int& width, int& height) override;
+    void finishDrawing() override;
     /// Where readDepth reads from: the framebuffer and viewport the frame draws into (the
     /// Engine passes the caller's, frame_contract.hpp). Queries and batched tests need no
     /// target: they draw into whatever framebuffer is bound.

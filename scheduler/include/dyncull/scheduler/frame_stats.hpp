@@ -19,6 +19,11 @@ struct FrameStats {
     std::uint32_t rasterTests = 0;    ///< two-phase: volumes in batched raster tests (QueryBackend::testVolumes)
     std::uint32_t rasterBatches = 0;  ///< two-phase: batched raster tests issued
     double rasterMs = 0.0;            ///< two-phase: building, drawing and waiting for the batched raster tests
+    /// Two-phase with SchedulerTuning::splitDrawWaits: of depthReadMs and rasterMs, the time
+    /// spent waiting for the drawing submitted before them, and the CPU in the late pass's
+    /// pyramid tests (footprint and pyramid reads; in traversalMs). 0 otherwise.
+    double drawWaitMs = 0.0;
+    double pyramidTestMs = 0.0;
     std::uint32_t triangleTests = 0;  ///< two-phase: parts tested on their own triangles (PartSink::testParts)
     double triangleTestMs = 0.0;      ///< two-phase: drawing and waiting for the triangle tests, and reading the draw marks
     std::uint32_t drawMarksHidden = 0;  ///< two-phase: parts drawn whose draw showed no sample

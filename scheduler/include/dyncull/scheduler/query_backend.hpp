@@ -114,6 +114,9 @@ public:
         (void)depth, (void)width, (void)height;
         return false;
     }
+    /// Blocks until everything submitted so far has been drawn (glFinish). Only for
+    /// measurement (SchedulerTuning::splitDrawWaits); the default returns at once.
+    virtual void finishDrawing() {}
     /// The batched raster test (NVIDIA's gl_occlusion_culling sample): every volume is
     /// drawn in one pass against the depth drawn so far, and each fragment that passes
     /// marks its volume visible. The answer rule is issue()'s (exact per pixel, enlarged

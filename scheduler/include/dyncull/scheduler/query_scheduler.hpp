@@ -247,6 +247,12 @@ struct SchedulerTuning {
     /// drew 4% fewer triangles than 1 on the power plant (3 no fewer than 2), 6% on the city
     /// (docs/BENCHMARKS.md, "candidate rounds").
     std::uint32_t candidateRounds = 2;
+    /// Measurement, not speed: before each depth read and batched raster test, wait for the
+    /// drawing submitted so far (QueryBackend::finishDrawing) and time it apart, and time the
+    /// pyramid tests, so that a test's own cost is told apart from the drawing it waits for
+    /// (FrameStats::drawWaitMs, pyramidTestMs). Both waits happen anyway inside the read and
+    /// the test; splitting them off costs a sync only where the backend would overlap.
+    bool splitDrawWaits = false;
     TestCosts costs;
 };
 
@@ -466,6 +472,9 @@ private:
     /// frame's stats; pyramidView_ follows). False if the backend cannot read it at the
     /// frame's size: pyramidView_ is cleared, and nothing may be tested against pyramid_.
     bool buildPyramid(Frame& f);
+    /// With SchedulerTuning::splitDrawWaits: waits for the drawing so far, timed into
+    /// FrameStats::drawWaitMs. Nothing otherwise.
+    void splitDrawWait(Frame& f);
     /// The late pass: every node tested against the pyramid (if `haveDepth`), the parts it
     /// lets through collected for the raster test (if this frame is `testing`) or drawn.
     void lateTraversal(Frame& f, bool testing, bool haveDepth, bool triangles);
