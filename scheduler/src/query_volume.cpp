@@ -50,23 +50,37 @@ std::uint32_t QueryVolume::enlargedForRounding(const glm::dvec3& eye, std::array
     const std::uint32_t nv = vertexCount;
     glm::dvec3 centre(0.0);
     double magnitude = 0.0;
+    const double share = 1.0 / double(nv);
     for (std::uint32_t i = 0; i < nv; ++i) {
         const glm::dvec3 v(vertices[i]);
-        centre += v / double(nv);
+        centre += v * share;
         magnitude = std::max({magnitude, std::abs(v.x), std::abs(v.y), std::abs(v.z)});
     }
     const double slack = magnitude * 0x1p-22, push = slack * std::sqrt(3.0);
     // Scaling about the centre moves every face out by (k - 1) times its distance from the
     // centre and keeps its normal, so k = 1 + push / (nearest face distance) moves each
     // face out by at least `push` (a per-axis push would slide tilted faces along themselves).
-    double nearest = std::numeric_limits<double>::infinity();
+    // The nearest face's distance, dot(n, a - centre)^2 / |n|^2 at its least, compared as
+    // cross products of the ratios so that only the least takes a square root. In units of
+    // a power of two near the magnitude (exact), so that the fifth powers cannot overflow.
+    int exponent = 0;
+    std::frexp(magnitude, &exponent);
+    const double unit = std::ldexp(1.0, exponent), perUnit = std::ldexp(1.0, -exponent);
+    const glm::dvec3 scaledCentre = centre * perUnit;
+    double bestDot2 = std::numeric_limits<double>::infinity(), bestLen2 = 1.0;
     const std::span<const std::uint8_t> tris = triangles();
     for (std::size_t t = 0; t + 2 < tris.size(); t += 3) {
-        const glm::dvec3 a(vertices[tris[t]]), b(vertices[tris[t + 1]]), c(vertices[tris[t + 2]]);
+        const glm::dvec3 a = glm::dvec3(vertices[tris[t]]) * perUnit, b = glm::dvec3(vertices[tris[t + 1]]) * perUnit,
+                         c = glm::dvec3(vertices[tris[t + 2]]) * perUnit;
         const glm::dvec3 n = glm::cross(b - a, c - a);
-        const double len = glm::length(n);
-        if (len > 0.0) nearest = std::min(nearest, std::abs(glm::dot(n, a - centre)) / len);  // zero-area: no face
+        const double len2 = glm::dot(n, n), d = glm::dot(n, a - scaledCentre), dot2 = d * d;
+        if (len2 > 0.0 && dot2 * bestLen2 < bestDot2 * len2) {  // zero-area: no face
+            bestDot2 = dot2;
+            bestLen2 = len2;
+        }
     }
+    const double nearest =
+        std::isfinite(bestDot2) ? std::sqrt(bestDot2 / bestLen2) * unit : std::numeric_limits<double>::infinity();
     // Thinner than a few roundings (e.g. collapsed flat by them): its vertices' axis-aligned
     // box instead, each face pushed out along its axis; on an axis where the box is flat the
     // corner's index bit says which side it belongs to.

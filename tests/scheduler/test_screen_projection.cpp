@@ -129,5 +129,45 @@ TEST(ScreenProjection, BoxAroundTheEyeIsVisible) {
     EXPECT_FALSE(screen.boxDepth(screen.objectProjection(m), Aabb::fromMinMax({-1.0f, -1.0f, -1.0f}, {1.0f, 1.0f, 1.0f}), fp));
 }
 
+// QueryVolume::enlargedForRounding moves every face of a volume out by at least its margin
+// (the vertices' magnitude times 2^-22 sqrt 3): checked per triangle against the distances
+// computed plainly (a square root per face), on transformed boxes and k-DOP-like volumes
+// from near the origin to 1e30 from it.
+TEST(QueryVolume, EnlargedForRoundingPushesEveryFaceOutByItsMargin) {
+    std::mt19937 rng(11);
+    int checked = 0;
+    for (const float scale : {1.0f, 1e4f, 1e7f, 1e30f}) {
+        for (int n = 0; n < 200; ++n) {
+            const Case c = randomCase(rng, false, scale);
+            const QueryVolume v = QueryVolume::fromTransformedBox(c.matrix, c.box);
+            std::array<glm::dvec3, QueryVolume::kMaxVertices> out;
+            bool asBox = false;
+            const std::uint32_t count = v.enlargedForRounding(glm::dvec3(0.0), out, asBox);
+            if (asBox) continue;  // too thin for faces: its box, tested by the volume paths
+            ASSERT_EQ(count, v.vertexCount);
+            double magnitude = 0.0;
+            glm::dvec3 centre(0.0);
+            for (const glm::vec3& p : v.points()) {
+                magnitude = std::max({magnitude, std::abs(double(p.x)), std::abs(double(p.y)), std::abs(double(p.z))});
+                centre += glm::dvec3(p) / 8.0;
+            }
+            const double push = magnitude * 0x1p-22 * std::sqrt(3.0);
+            const std::span<const std::uint8_t> tris = v.triangles();
+            for (std::size_t t = 0; t + 2 < tris.size(); t += 3) {
+                const glm::dvec3 a(v.vertices[tris[t]]), b(v.vertices[tris[t + 1]]), d(v.vertices[tris[t + 2]]);
+                glm::dvec3 normal = glm::cross(b - a, d - a);
+                if (glm::length(normal) == 0.0) continue;
+                normal = glm::normalize(normal);
+                if (glm::dot(normal, a - centre) < 0.0) normal = -normal;  // outward
+                // Every enlarged vertex of the face lies at least `push` beyond its plane.
+                for (std::size_t k = 0; k < 3; ++k)
+                    EXPECT_GE(glm::dot(normal, out[tris[t + k]] - a), push * (1.0 - 1e-9)) << scale << " triangle " << t / 3;
+                ++checked;
+            }
+        }
+    }
+    EXPECT_GT(checked, 4 * 150 * 12);
+}
+
 }  // namespace
 }  // namespace dyncull
