@@ -78,7 +78,7 @@ bool applyTwoPhaseName(const std::string& part, ModeSpec& m) {
     }
     if (part != "full" && part != "full-hzb" && part != "full-nohist" && part != "full-nocost" && part != "full-tri" &&
         part != "full-noclusters" && part != "full-noclusterhist" && part != "full-markclusterhist" && part != "full-noworker" &&
-        part != "full-ring" && part != "full-splitwaits")
+        part != "full-ring" && part != "full-splitwaits" && part != "full-noroundpyramid")
         return false;
     m.scheduler.mode = CullMode::TwoPhase;
     m.scheduler.features.useBatchedRaster = part != "full-hzb";
@@ -97,6 +97,7 @@ bool applyTwoPhaseName(const std::string& part, ModeSpec& m) {
     m.scheduler.features.useClusterWorker = part != "full-noworker";
     if (part == "full-ring") m.queries.snapping = SnappingMargin::Ring;
     m.scheduler.tuning.splitDrawWaits = part == "full-splitwaits";
+    m.scheduler.features.useRoundPyramids = part != "full-noroundpyramid";
     return true;
 }
 
@@ -107,7 +108,7 @@ std::string modeNamesHelp() {
            "queries (hardware occlusion queries with history, batching and occupancy maps; the default before two-phase), oracle (the visible parts, whole), oracle-clusters (only their clusters that own a pixel), "
            "oracle-boxes (every cluster whose box passes against the final depth: the floor of a cluster-box culler; measures --volume-bound), "
            "oracle-budgetP (oracle-clusters less what an oracle with a budget of P% of the pixels leaves out); "
-           "ablations of full: full-hzb (the pyramid alone), full-tri (every part whose volume passes then tested on its own triangles, and draws marked), full-nohist (every part drawn early tested again each frame), full-nocost (every volume the pyramid lets through tested), full-noclusters (parts drawn whole, no cluster tests), full-noclusterhist (early parts drawn with all their clusters, not only those that showed last frame), full-markclusterhist (which clusters showed judged by their fragments' marks when drawn, not by their boxes against the final depth), full-noworker (the deferred clusters tested on the render thread as they are drawn, not ahead of them on a worker), full-ring (every volume's outline widened by a ring, boxes not grown across the view), full-splitwaits (full, measuring: waits for the drawing apart before each depth read and raster test, and times the pyramid tests: the Cheap tests table's own cost per test); "
+           "ablations of full: full-hzb (the pyramid alone), full-tri (every part whose volume passes then tested on its own triangles, and draws marked), full-nohist (every part drawn early tested again each frame), full-nocost (every volume the pyramid lets through tested), full-noclusters (parts drawn whole, no cluster tests), full-noclusterhist (early parts drawn with all their clusters, not only those that showed last frame), full-markclusterhist (which clusters showed judged by their fragments' marks when drawn, not by their boxes against the final depth), full-noworker (the deferred clusters tested on the render thread as they are drawn, not ahead of them on a worker), full-ring (every volume's outline widened by a ring, boxes not grown across the view), full-noroundpyramid (the clusters of parts drawn after a raster test tested against the early pass's pyramid, not one built again before their round), full-splitwaits (full, measuring: waits for the drawing apart before each depth read and raster test, and times the pyramid tests: the Cheap tests table's own cost per test); "
            "vfc-noclusters (vfc drawing parts whole); "
            "approximate full: budgetP (at most P percent of the frame's pixels lost, e.g. budget0.1), budgetearlyP (and early-set parts showing less than the budget handed to it), budgetrecountP (the parts that could fit drawn last, counted again against the depth of the rest); "
            "settings of queries: approximate thrN (pixel threshold), latency1 (last frame's results), "

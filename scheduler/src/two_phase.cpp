@@ -260,6 +260,7 @@ void QueryScheduler::testCandidates(Frame& f, bool triangles) {
             rasterTest(f, candidates_, false);
             budgetCulled_.assign(candidates_.size(), kBudgetNo);
             learnOccludedRate(candidateOccludedRate_, rasterAnswers_);
+            refreshClusterPyramid(f);
             settleCandidates(f, triangles);
         }
         return;
@@ -268,12 +269,14 @@ void QueryScheduler::testCandidates(Frame& f, bool triangles) {
     budgetCulled_.assign(candidates_.size(), kBudgetNo);
     if (!budget) {
         learnOccludedRate(candidateOccludedRate_, rasterAnswers_);
+        refreshClusterPyramid(f);
         settleCandidates(f, triangles);
         return;
     }
     if (!params_.approx.budgetRecount) {
         spendErrorBudget(f);
         learnOccludedRate(candidateOccludedRate_, rasterAnswers_);  // budget culls save drawing too
+        refreshClusterPyramid(f);
         settleCandidates(f, triangles);
         return;
     }
@@ -288,13 +291,27 @@ void QueryScheduler::testCandidates(Frame& f, bool triangles) {
             waitingParts_.push_back(candidates_[i]);
         }
     learnOccludedRate(candidateOccludedRate_, rasterAnswers_);
+    refreshClusterPyramid(f);
     settleCandidates(f, triangles);
     if (waitingParts_.empty()) return;
     candidates_.swap(waitingParts_);
     rasterTest(f, candidates_, true);
     budgetCulled_.assign(candidates_.size(), kBudgetNo);
     spendErrorBudget(f);
+    refreshClusterPyramid(f);
     settleCandidates(f, triangles);
+}
+
+void QueryScheduler::refreshClusterPyramid(Frame& f) {
+    // The raster test's answers waited for everything drawn before it, so the read only
+    // copies. The deferred clusters' worker, which reads the pyramid, is joined by now.
+    if (!params_.features.useRoundPyramids || !f.clusterPyramid || !params_.features.useClusters || !f.sink.drawsRanges()) return;
+    std::uint64_t triangles = 0;
+    for (std::size_t i = 0; i < candidates_.size(); ++i)
+        if (rasterAnswers_[i] != QueryResult::Occluded && budgetCulled_[i] == kBudgetNo) triangles += subtreeTriangles(f, candidates_[i]);
+    const TestCosts& c = params_.tuning.costs;
+    if (params_.features.useCostModel && double(triangles) * c.drawNsPerTriangle * c.roundPyramidCulls <= c.pyramidNs) return;
+    f.clusterPyramid = buildPyramid(f);
 }
 
 void QueryScheduler::settleCandidates(Frame& f, bool triangles) {

@@ -227,3 +227,40 @@ TEST_F(ClusterCulling, PixelSizedClustersKeepTheImageExact) {
 
 }  // namespace
 }  // namespace dyncull
+
+namespace dyncull {
+namespace {
+
+TEST_F(ClusterHistory, RoundPyramidsKeepTheImageAndCullMore) {
+    // The clusters of the parts a round of raster tests lets through are tested against a
+    // pyramid built again from the depth drawn so far (useRoundPyramids), not the early
+    // pass's: the same image as without, and as vfc's, every frame, with fewer triangles.
+    build({2000, 8, 3.2f, 1.0f, {2.2f, 1.6f, 2.2f}});
+    if (HasFatalFailure()) return;
+    SchedulerParams round = paramsOf(CullMode::TwoPhase, true), early = round;
+    ASSERT_TRUE(round.features.useRoundPyramids);
+    early.features.useRoundPyramids = false;
+    QueryScheduler a(round), b(early), vfc(paramsOf(CullMode::Vfc, true));
+    std::uint64_t drawnRound = 0, drawnEarly = 0, extraBuilds = 0;
+    for (int f = 0; f < 24; ++f) {
+        SCOPED_TRACE("frame " + std::to_string(f));
+        circle(0.25f * float(f), 8.0f, 1.0f);
+        Image images[3];
+        const FrameStats x = render(a, images[0]);
+        const FrameStats y = render(b, images[1]);
+        render(vfc, images[2]);
+        EXPECT_EQ(differingPixels(images[0], images[1]), 0u);
+        EXPECT_EQ(differingPixels(images[0], images[2]), 0u);
+        drawnRound += x.trianglesDrawn;
+        drawnEarly += y.trianglesDrawn;
+        extraBuilds += x.pyramidBuilds - y.pyramidBuilds;
+    }
+    std::printf("round pyramids: %llu more built, %llu triangles drawn against %llu\n", static_cast<unsigned long long>(extraBuilds),
+                static_cast<unsigned long long>(drawnRound), static_cast<unsigned long long>(drawnEarly));
+    EXPECT_GT(extraBuilds, 0u);
+    EXPECT_LT(drawnRound, drawnEarly);
+    EXPECT_EQ(ctx_->checkErrors(), 0u);
+}
+
+}  // namespace
+}  // namespace dyncull

@@ -115,6 +115,11 @@ struct SchedulerFeatures {
     /// depend only on the early pyramid), instead of part by part as they are drawn. The
     /// same decisions either way; off: on the render thread (the reference).
     bool useClusterWorker = true;
+    /// TwoPhase with clusters: before the parts a round of raster tests let through are
+    /// drawn, the pyramid is built again from the depth drawn so far (which that round's
+    /// answer has waited for already), so their clusters are tested against it rather
+    /// than the early pass's depth. Off: an ablation, bench mode full-noroundpyramid.
+    bool useRoundPyramids = true;
     /// TwoPhase (and clusters): test only where SchedulerTuning::costs expects the test to
     /// pay. Off: every volume the pyramid lets through is tested (an ablation).
     bool useCostModel = true;
@@ -183,6 +188,11 @@ inline std::uint64_t errorBudgetPixels(double percent, int width, int height) {
 /// `cluster_tests`), and a gap of culled clusters between drawn ones is skipped only if
 /// its drawing costs more than `drawNsPerRange`, one more range of the multi-draw
 /// (`bench_draw_speed`: parts-clusters against parts; nothing measurable on llvmpipe).
+/// The pyramid is built again before a round of tested parts is drawn (useRoundPyramids)
+/// where their triangles times `roundPyramidCulls`, the share of them that a pyramid of the
+/// depth drawn so far culls beyond the early one (27% on the power plant, 39% on the city,
+/// 60% on the bunny path), are worth more drawing than `pyramidNs`, a depth read that
+/// waits for nothing and the build (`bench_volume_tests`, `bench_depth_pyramid`).
 struct TestCosts {
     double drawNsPerTriangle = 53.0;
     double testNsPerVolume = 2700.0;
@@ -192,6 +202,8 @@ struct TestCosts {
     double clusterTestNs = 90.0;
     double drawNsPerRange = 0.0;
     double depthReadNs = 400000.0;
+    double pyramidNs = 180000.0;
+    double roundPyramidCulls = 0.3;
     std::uint32_t probeFrames = 16;
 };
 
@@ -481,6 +493,9 @@ private:
     /// The batched raster test of candidates_, drawing the visible ones (or sending them
     /// on to triangle tests).
     void testCandidates(Frame& f, bool triangles);
+    /// SchedulerFeatures::useRoundPyramids: the pyramid built again from the depth drawn so
+    /// far, for the clusters of the parts about to be drawn, where TestCosts expects it to pay.
+    void refreshClusterPyramid(Frame& f);
     /// refresh_ tested against the final depth: a part hidden there is not drawn early next frame.
     void testRefresh(Frame& f);
     /// True if a triangle test of `ref` is expected to save more drawing than it costs.
