@@ -306,7 +306,8 @@ std::string sweepParamsHelp() {
     return "pixel-threshold, max-skip, skip-per-visible, small-feature, max-in-flight, tile-size, auto-saving (percent), "
            "latency (0 or 1 frames); error-budget (full; percent of the frame's pixels, decimals allowed); pyramid-span (full; "
            "texels a side of the late pass's pyramid tests, 2 to 64); cluster-span (full; the same for cluster tests); candidate-rounds (full; rounds of the late pass's raster tests, 1 to 16); test-ns (full; the cost model's nanoseconds per batched volume "
-           "test, TestCosts::testNsPerVolume)";
+           "test, TestCosts::testNsPerVolume); pyramid-ns (full; the cost model's nanoseconds per pyramid built again before a round, "
+           "TestCosts::pyramidNs)";
 }
 
 Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec) {
@@ -350,6 +351,9 @@ Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec) {
         } else if (param == "cluster-span") {
             m.scheduler.mode = CullMode::TwoPhase;
             m.scheduler.tuning.clusterPyramidSpan = static_cast<int>(std::min<std::uint32_t>(v, 1u << 20));
+        } else if (param == "pyramid-ns") {
+            m.scheduler.mode = CullMode::TwoPhase;
+            m.scheduler.tuning.costs.pyramidNs = double(v);
         } else if (param == "test-ns") {
             m.scheduler.mode = CullMode::TwoPhase;
             m.scheduler.tuning.costs.testNsPerVolume = double(v);
