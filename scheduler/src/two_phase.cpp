@@ -5,10 +5,12 @@
 //  3. late pass: the tree is traversed front to back, every node tested against the
 //     pyramid (a rectangle and a depth, a few nanoseconds); an occluded node's subtree is
 //     skipped;
-//  4. the parts the pyramid let through are tested exactly, per pixel, in one batched
-//     raster test against the early depth (NVIDIA's gl_occlusion_culling "temporal current
-//     frame" scheme) and the visible ones drawn; then the parts drawn are tested against
-//     the final depth, and those visible there are next frame's early set.
+//  4. the parts the pyramid let through are tested exactly, per pixel, in batched raster
+//     tests (NVIDIA's gl_occlusion_culling "temporal current frame" scheme), in rounds
+//     front to back, each against the depth drawn before it, and the visible ones drawn
+//     (their clusters against a pyramid built again from that depth, where it pays); then
+//     the parts drawn are tested against the final depth, and those visible there are
+//     next frame's early set.
 // Where the sink draws clusters, the early set is kept per cluster: a part drawn early is
 // drawn as only the clusters whose boxes showed in the final depth of the frame it was last
 // drawn in, and its other clusters are tested against the pyramid in the late pass
