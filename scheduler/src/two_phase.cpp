@@ -186,7 +186,7 @@ void QueryScheduler::lateTraversal(Frame& f, bool testing, bool haveDepth, bool 
         // world box of a rotated part), scene nodes by their box; both grown by rounding.
         DepthFootprint fp;
         const auto tTest = params_.tuning.splitDrawWaits ? SchedulerClock::now() : SchedulerClock::time_point{};
-        const bool inFront = f.screen.volumeDepth(testedVolume(f, ref), fp);
+        const bool inFront = testedFootprint(f, ref, fp);
         const ScreenRect& rect = fp.rect;
         bool certain = false;  // visible without any test (near plane, camera inside)
         if (!inFront || box.contains(f.camera().position)) {
@@ -455,6 +455,19 @@ QueryVolume QueryScheduler::testedVolume(const Frame& f, NodeRef ref) const {
     // better of its two boxes (a k-DOP would have to save all of the box's area).
     const bool asClusters = drawsAsClusters(f, ref, f.objects.model(f.objects.modelOf(ref.object)));
     return objectNodeVolume(f.objects, ref, params_.tuning.volume, asClusters ? 1.0f : params_.tuning.autoVolumeSaving);
+}
+
+bool QueryScheduler::testedFootprint(const Frame& f, NodeRef ref, DepthFootprint& out) const {
+    if (ref.isSceneNode() || !params_.features.useTightVolumes) return f.screen.volumeDepth(testedVolume(f, ref), out);
+    const SceneObjects& objs = f.objects;
+    const LocalBsp& model = objs.model(objs.modelOf(ref.object));
+    const bool asClusters = drawsAsClusters(f, ref, model);
+    const bool box = params_.tuning.volume == VolumeChoice::Aabb || model.volumes.nodeCount() != model.nodes.size() ||
+                     chooseVolume(model.volumes, ref.node, params_.tuning.volume,
+                                  asClusters ? 1.0f : params_.tuning.autoVolumeSaving) == VolumeKind::Aabb;
+    if (!box || model.nodes[ref.node].box.empty()) return f.screen.volumeDepth(testedVolume(f, ref), out);
+    // objectNodeVolume's box: the node's local box under the object's matrix.
+    return f.screen.boxDepth(f.screen.objectProjection(objs.matrix(ref.object)), model.nodes[ref.node].box, out);
 }
 
 void QueryScheduler::rasterTest(Frame& f, const std::vector<NodeRef>& parts, bool countSamples) {

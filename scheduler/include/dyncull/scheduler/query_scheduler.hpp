@@ -316,6 +316,7 @@ QueryVolume objectNodeVolume(const SceneObjects& objects, NodeRef ref, VolumeCho
 /// borrows the tree, backend and sink for the duration of cullFrame.
 class QueryIssuer;
 class DeferredQueries;
+struct DepthFootprint;
 class DrawQueries;
 
 class QueryScheduler {
@@ -469,6 +470,10 @@ private:
     /// The volume `ref` is tested with in two-phase (world space): its world box for a
     /// scene node or without tight volumes, else its own volume under its object's matrix.
     QueryVolume testedVolume(const Frame& f, NodeRef ref) const;
+    /// testedVolume(f, ref)'s footprint (ScreenProjection::volumeDepth), a box's computed
+    /// from its centre and axes without building the volume (ScreenProjection::boxDepth);
+    /// false if it reaches the near plane.
+    bool testedFootprint(const Frame& f, NodeRef ref, DepthFootprint& out) const;
     /// The cost model's measured rates of "occluded" answers, for parts new this frame and
     /// for parts drawn early and tested again (moving averages over frames), and for the
     /// triangle tests of parts whose volumes passed.
