@@ -187,13 +187,29 @@ QueryVolume QueryScheduler::queryVolume(const Frame& f, NodeRef ref, const Aabb&
     return objectNodeVolume(f.objects, ref, params_.tuning.volume, params_.tuning.autoVolumeSaving);
 }
 
+VolumeKind objectNodeVolumeKind(const SceneObjects& objs, NodeRef ref, VolumeChoice volume, float autoSaving) {
+    assert(!ref.isSceneNode());
+    const LocalBsp& model = objs.model(objs.modelOf(ref.object));
+    if (volume == VolumeChoice::Aabb || model.volumes.nodeCount() != model.nodes.size()) return VolumeKind::Aabb;
+    return chooseVolume(model.volumes, ref.node, volume, autoSaving);
+}
+
+Aabb objectNodeBox(const SceneObjects& objs, NodeRef ref, VolumeChoice volume) {
+    assert(!ref.isSceneNode());
+    const LocalBsp& model = objs.model(objs.modelOf(ref.object));
+    if (volume == VolumeChoice::Aabb || model.volumes.nodeCount() != model.nodes.size()) return model.nodes[ref.node].box;
+    Aabb box;
+    for (const glm::vec3& p : model.volumes.verticesOf(model.volumes.get(ref.node, VolumeKind::Aabb))) box.extend(p);
+    return box;
+}
+
 QueryVolume objectNodeVolume(const SceneObjects& objs, NodeRef ref, VolumeChoice volume, float autoSaving) {
     assert(!ref.isSceneNode());
     const LocalBsp& model = objs.model(objs.modelOf(ref.object));
     const glm::mat4& m = objs.matrix(ref.object);
     if (volume == VolumeChoice::Aabb || model.volumes.nodeCount() != model.nodes.size())
         return QueryVolume::fromTransformedBox(m, model.nodes[ref.node].box);
-    const VolumeKind kind = chooseVolume(model.volumes, ref.node, volume, autoSaving);
+    const VolumeKind kind = objectNodeVolumeKind(objs, ref, volume, autoSaving);
     const NodeVolume& v = model.volumes.get(ref.node, kind);
     if (v.vertexCount == 0)  // empty node: never reached in practice
         return QueryVolume::fromAabb(transformAabb(m, model.nodes[ref.node].box));

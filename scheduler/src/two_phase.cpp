@@ -449,25 +449,26 @@ bool QueryScheduler::exploring(NodeRef ref) const {
 
 QueryVolume QueryScheduler::testedVolume(const Frame& f, NodeRef ref) const {
     if (ref.isSceneNode() || !params_.features.useTightVolumes) return QueryVolume::fromAabb(f.tree.worldBox(ref));
+    return objectNodeVolume(f.objects, ref, params_.tuning.volume, testedAutoSaving(f, ref));
+}
+
+float QueryScheduler::testedAutoSaving(const Frame& f, NodeRef ref) const {
     // A part drawn as clusters has its clusters' boxes tested against the pyramid once its
     // volume passes, and they bound it tighter than any one volume: a k-DOP's extra
     // triangles then cost every pyramid and raster test and save little, so Auto takes the
     // better of its two boxes (a k-DOP would have to save all of the box's area).
     const bool asClusters = drawsAsClusters(f, ref, f.objects.model(f.objects.modelOf(ref.object)));
-    return objectNodeVolume(f.objects, ref, params_.tuning.volume, asClusters ? 1.0f : params_.tuning.autoVolumeSaving);
+    return asClusters ? 1.0f : params_.tuning.autoVolumeSaving;
 }
 
 bool QueryScheduler::testedFootprint(const Frame& f, NodeRef ref, DepthFootprint& out) const {
     if (ref.isSceneNode() || !params_.features.useTightVolumes) return f.screen.volumeDepth(testedVolume(f, ref), out);
     const SceneObjects& objs = f.objects;
-    const LocalBsp& model = objs.model(objs.modelOf(ref.object));
-    const bool asClusters = drawsAsClusters(f, ref, model);
-    const bool box = params_.tuning.volume == VolumeChoice::Aabb || model.volumes.nodeCount() != model.nodes.size() ||
-                     chooseVolume(model.volumes, ref.node, params_.tuning.volume,
-                                  asClusters ? 1.0f : params_.tuning.autoVolumeSaving) == VolumeKind::Aabb;
-    if (!box || model.nodes[ref.node].box.empty()) return f.screen.volumeDepth(testedVolume(f, ref), out);
-    // objectNodeVolume's box: the node's local box under the object's matrix.
-    return f.screen.boxDepth(f.screen.objectProjection(objs.matrix(ref.object)), model.nodes[ref.node].box, out);
+    if (objectNodeVolumeKind(objs, ref, params_.tuning.volume, testedAutoSaving(f, ref)) != VolumeKind::Aabb)
+        return f.screen.volumeDepth(testedVolume(f, ref), out);
+    const Aabb box = objectNodeBox(objs, ref, params_.tuning.volume);
+    if (box.empty()) return f.screen.volumeDepth(testedVolume(f, ref), out);
+    return f.screen.boxDepth(f.screen.objectProjection(objs.matrix(ref.object)), box, out);
 }
 
 void QueryScheduler::rasterTest(Frame& f, const std::vector<NodeRef>& parts, bool countSamples) {

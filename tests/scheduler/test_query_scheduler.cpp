@@ -12,6 +12,7 @@
 #include <set>
 #include <string>
 #include <thread>
+#include <tuple>
 
 #include "dyncull/bsp/local_bsp.hpp"
 #include "dyncull/bsp/loose_bsp.hpp"
@@ -608,6 +609,39 @@ TEST(QueryVolume, NodeVolumesAreTransformedVertexByVertex) {
     const QueryVolume a = QueryVolume::fromNodeVolume(m, bsp.volumes, bsp.volumes.get(0, VolumeKind::Aabb));
     const QueryVolume b = QueryVolume::fromTransformedBox(m, bsp.nodes[0].box);
     for (int i = 0; i < 8; ++i) EXPECT_EQ(a.vertices[i], b.vertices[i]);
+}
+
+// objectNodeVolumeKind and objectNodeBox say what objectNodeVolume builds: wherever the kind
+// is Aabb, its vertices are those of objectNodeBox under the object's matrix (the two-phase
+// pyramid test projects that box without building the volume), for every choice of volume.
+TEST(QueryVolume, ObjectNodeBoxIsTheBoxObjectNodeVolumeTransforms) {
+    LocalBspParams lp;
+    lp.maxLeafTriangles = 400;
+    SceneObjects objs;
+    const ModelId model = objs.addModel(buildLocalBsp(lumpySphere(), lp).take());
+    Transform t;
+    t.translation = {3, -1, 2};
+    t.rotation = glm::angleAxis(1.0f, glm::normalize(glm::vec3(0.2f, 1, -0.4f)));
+    t.scale = {2.0f, 0.5f, 1.0f};
+    const ObjectHandle h = objs.addObject(model, t).take();
+    const glm::mat4& m = objs.matrix(h.index);
+    int boxes = 0;
+    for (const VolumeChoice choice : {VolumeChoice::Aabb, VolumeChoice::Obb, VolumeChoice::Auto})
+        for (const float saving : {0.0f, 0.1f, 1.0f})
+            for (std::uint32_t n = 0; n < objs.model(model).nodes.size(); ++n) {
+                const NodeRef ref{h.index, n};
+                if (objectNodeVolumeKind(objs, ref, choice, saving) != VolumeKind::Aabb) continue;
+                const QueryVolume v = objectNodeVolume(objs, ref, choice, saving);
+                const QueryVolume b = QueryVolume::fromTransformedBox(m, objectNodeBox(objs, ref, choice));
+                ASSERT_EQ(v.vertexCount, 8u);
+                std::vector<glm::vec3> a(v.points().begin(), v.points().end()), c(b.points().begin(), b.points().end());
+                auto less = [](const glm::vec3& x, const glm::vec3& y) { return std::tie(x.x, x.y, x.z) < std::tie(y.x, y.y, y.z); };
+                std::sort(a.begin(), a.end(), less);
+                std::sort(c.begin(), c.end(), less);
+                EXPECT_EQ(a, c) << "node " << n;
+                ++boxes;
+            }
+    EXPECT_GT(boxes, 0);
 }
 
 // ---- Draw queries: parts drawn without a query of their own are drawn inside a query

@@ -311,6 +311,12 @@ Status validateSchedulerParams(const SchedulerParams& p);
 /// when the model has no volumes — under the object's current matrix. Its world AABB
 /// (`objects`' worldBox of the node) for a node with no stored vertices.
 QueryVolume objectNodeVolume(const SceneObjects& objects, NodeRef ref, VolumeChoice volume, float autoSaving);
+/// The kind objectNodeVolume takes for those arguments: Aabb also where the model has no
+/// stored volumes.
+VolumeKind objectNodeVolumeKind(const SceneObjects& objects, NodeRef ref, VolumeChoice volume, float autoSaving);
+/// Where that kind is Aabb, the object-space box whose corners objectNodeVolume transforms:
+/// the node's box, or its stored box volume's; empty where it takes the world AABB instead.
+Aabb objectNodeBox(const SceneObjects& objects, NodeRef ref, VolumeChoice volume);
 
 /// Runs one frame of culling and drawing. Owns the visibility history between frames;
 /// borrows the tree, backend and sink for the duration of cullFrame.
@@ -470,6 +476,8 @@ private:
     /// The volume `ref` is tested with in two-phase (world space): its world box for a
     /// scene node or without tight volumes, else its own volume under its object's matrix.
     QueryVolume testedVolume(const Frame& f, NodeRef ref) const;
+    /// The autoSaving testedVolume passes to objectNodeVolume for object node `ref`.
+    float testedAutoSaving(const Frame& f, NodeRef ref) const;
     /// testedVolume(f, ref)'s footprint (ScreenProjection::volumeDepth), a box's computed
     /// from its centre and axes without building the volume (ScreenProjection::boxDepth);
     /// false if it reaches the near plane.
