@@ -192,7 +192,8 @@ inline std::uint64_t errorBudgetPixels(double percent, int width, int height) {
 /// where their triangles times `roundPyramidCulls`, the share of them that a pyramid of the
 /// depth drawn so far culls beyond the early one (27% on the power plant, 39% on the city,
 /// 60% on the bunny path), are worth more drawing than `pyramidNs`, a depth read that
-/// waits for nothing and the build (`bench_volume_tests`, `bench_depth_pyramid`).
+/// waits for nothing and the build (`bench_volume_tests`, `bench_depth_pyramid`). Cluster
+/// history's record at the frame's end is priced the same: `pyramidNs` plus its tests' CPU.
 struct TestCosts {
     double drawNsPerTriangle = 53.0;
     double testNsPerVolume = 2700.0;
