@@ -187,17 +187,25 @@ QueryVolume QueryScheduler::queryVolume(const Frame& f, NodeRef ref, const Aabb&
     return objectNodeVolume(f.objects, ref, params_.tuning.volume, params_.tuning.autoVolumeSaving);
 }
 
+namespace {
+/// Whether objectNodeVolume takes the node's own box: the box was asked for, or the model
+/// has no stored volumes.
+bool nodeBoxOnly(const LocalBsp& model, VolumeChoice volume) {
+    return volume == VolumeChoice::Aabb || model.volumes.nodeCount() != model.nodes.size();
+}
+}  // namespace
+
 VolumeKind objectNodeVolumeKind(const SceneObjects& objs, NodeRef ref, VolumeChoice volume, float autoSaving) {
     assert(!ref.isSceneNode());
     const LocalBsp& model = objs.model(objs.modelOf(ref.object));
-    if (volume == VolumeChoice::Aabb || model.volumes.nodeCount() != model.nodes.size()) return VolumeKind::Aabb;
+    if (nodeBoxOnly(model, volume)) return VolumeKind::Aabb;
     return chooseVolume(model.volumes, ref.node, volume, autoSaving);
 }
 
 Aabb objectNodeBox(const SceneObjects& objs, NodeRef ref, VolumeChoice volume) {
     assert(!ref.isSceneNode());
     const LocalBsp& model = objs.model(objs.modelOf(ref.object));
-    if (volume == VolumeChoice::Aabb || model.volumes.nodeCount() != model.nodes.size()) return model.nodes[ref.node].box;
+    if (nodeBoxOnly(model, volume)) return model.nodes[ref.node].box;
     Aabb box;
     for (const glm::vec3& p : model.volumes.verticesOf(model.volumes.get(ref.node, VolumeKind::Aabb))) box.extend(p);
     return box;
@@ -207,8 +215,7 @@ QueryVolume objectNodeVolume(const SceneObjects& objs, NodeRef ref, VolumeChoice
     assert(!ref.isSceneNode());
     const LocalBsp& model = objs.model(objs.modelOf(ref.object));
     const glm::mat4& m = objs.matrix(ref.object);
-    if (volume == VolumeChoice::Aabb || model.volumes.nodeCount() != model.nodes.size())
-        return QueryVolume::fromTransformedBox(m, model.nodes[ref.node].box);
+    if (nodeBoxOnly(model, volume)) return QueryVolume::fromTransformedBox(m, model.nodes[ref.node].box);
     const VolumeKind kind = objectNodeVolumeKind(objs, ref, volume, autoSaving);
     const NodeVolume& v = model.volumes.get(ref.node, kind);
     if (v.vertexCount == 0)  // empty node: never reached in practice

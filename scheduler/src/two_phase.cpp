@@ -251,10 +251,10 @@ void learnOccludedRate(double& rate, const std::vector<QueryResult>& answers) {
 
 void QueryScheduler::testCandidates(Frame& f, bool triangles) {
     const bool budget = params_.approx.errorBudgetPercent > 0.0;
-    const std::size_t rounds = budget ? 1 : std::min<std::size_t>(params_.tuning.candidateRounds, candidates_.size());
-    if (rounds > 1) {
-        // Front to back (the traversal's order): a later round is tested against the depth
-        // of the earlier rounds' visible parts too.
+    if (!budget) {
+        // In rounds, front to back (the traversal's order): a later round is tested against
+        // the depth of the earlier rounds' visible parts too.
+        const std::size_t rounds = std::min<std::size_t>(params_.tuning.candidateRounds, candidates_.size());
         allCandidates_.swap(candidates_);
         for (std::size_t r = 0; r < rounds; ++r) {
             const std::size_t begin = allCandidates_.size() * r / rounds, end = allCandidates_.size() * (r + 1) / rounds;
@@ -267,14 +267,8 @@ void QueryScheduler::testCandidates(Frame& f, bool triangles) {
         }
         return;
     }
-    rasterTest(f, candidates_, budget);
+    rasterTest(f, candidates_, true);
     budgetCulled_.assign(candidates_.size(), kBudgetNo);
-    if (!budget) {
-        learnOccludedRate(candidateOccludedRate_, rasterAnswers_);
-        refreshClusterPyramid(f);
-        settleCandidates(f, triangles);
-        return;
-    }
     if (!params_.approx.budgetRecount) {
         spendErrorBudget(f);
         learnOccludedRate(candidateOccludedRate_, rasterAnswers_);  // budget culls save drawing too
