@@ -78,7 +78,8 @@ bool applyTwoPhaseName(const std::string& part, ModeSpec& m) {
     }
     if (part != "full" && part != "full-hzb" && part != "full-nohist" && part != "full-nocost" && part != "full-tri" &&
         part != "full-noclusters" && part != "full-noclusterhist" && part != "full-markclusterhist" && part != "full-noworker" &&
-        part != "full-ring" && part != "full-splitwaits" && part != "full-noroundpyramid")
+        part != "full-ring" && part != "full-splitwaits" && part != "full-noroundpyramid" &&
+        part != "full-nosubmit")
         return false;
     m.scheduler.mode = CullMode::TwoPhase;
     m.scheduler.features.useBatchedRaster = part != "full-hzb";
@@ -98,6 +99,7 @@ bool applyTwoPhaseName(const std::string& part, ModeSpec& m) {
     if (part == "full-ring") m.queries.snapping = SnappingMargin::Ring;
     m.scheduler.tuning.splitDrawWaits = part == "full-splitwaits";
     m.scheduler.features.useRoundPyramids = part != "full-noroundpyramid";
+    if (part == "full-nosubmit") m.submitTriangles = 0;
     return true;
 }
 
@@ -108,7 +110,7 @@ std::string modeNamesHelp() {
            "queries (hardware occlusion queries with history, batching and occupancy maps; the default before two-phase), oracle (the visible parts, whole), oracle-clusters (only their clusters that own a pixel), "
            "oracle-boxes (every cluster whose box passes against the final depth: the floor of a cluster-box culler; measures --volume-bound), "
            "oracle-budgetP (oracle-clusters less what an oracle with a budget of P% of the pixels leaves out); "
-           "ablations of full: full-hzb (the pyramid alone), full-tri (every part whose volume passes then tested on its own triangles, and draws marked), full-nohist (every part drawn early tested again each frame), full-nocost (every volume the pyramid lets through tested), full-noclusters (parts drawn whole, no cluster tests), full-noclusterhist (early parts drawn with all their clusters, not only those that showed last frame), full-markclusterhist (which clusters showed judged by their fragments' marks when drawn, not by their boxes against the final depth), full-noworker (the deferred clusters tested on the render thread as they are drawn, not ahead of them on a worker), full-ring (every volume's outline widened by a ring, boxes not grown across the view), full-noroundpyramid (the clusters of parts drawn after a raster test tested against the early pass's pyramid, not one built again before their round), full-splitwaits (full, measuring: waits for the drawing apart before each depth read and raster test, and times the pyramid tests: the Cheap tests table's own cost per test); "
+           "ablations of full: full-hzb (the pyramid alone), full-tri (every part whose volume passes then tested on its own triangles, and draws marked), full-nohist (every part drawn early tested again each frame), full-nocost (every volume the pyramid lets through tested), full-noclusters (parts drawn whole, no cluster tests), full-noclusterhist (early parts drawn with all their clusters, not only those that showed last frame), full-markclusterhist (which clusters showed judged by their fragments' marks when drawn, not by their boxes against the final depth), full-noworker (the deferred clusters tested on the render thread as they are drawn, not ahead of them on a worker), full-ring (every volume's outline widened by a ring, boxes not grown across the view), full-noroundpyramid (the clusters of parts drawn after a raster test tested against the early pass's pyramid, not one built again before their round), full-splitwaits (full, measuring: waits for the drawing apart before each depth read and raster test, and times the pyramid tests: the Cheap tests table's own cost per test), full-nosubmit (full with its drawing handed to the GPU only where it reads something back, not every EngineOptions::submitTriangles triangles); "
            "vfc-noclusters (vfc drawing parts whole); "
            "approximate full: budgetP (at most P percent of the frame's pixels lost, e.g. budget0.1), budgetearlyP (and early-set parts showing less than the budget handed to it), budgetrecountP (the parts that could fit drawn last, counted again against the depth of the rest); "
            "settings of queries: approximate thrN (pixel threshold), latency1 (last frame's results), "
@@ -307,7 +309,7 @@ std::string sweepParamsHelp() {
            "latency (0 or 1 frames); error-budget (full; percent of the frame's pixels, decimals allowed); pyramid-span (full; "
            "texels a side of the late pass's pyramid tests, 2 to 64); cluster-span (full; the same for cluster tests); candidate-rounds (full; rounds of the late pass's raster tests, 1 to 16); test-ns (full; the cost model's nanoseconds per batched volume "
            "test, TestCosts::testNsPerVolume); pyramid-ns (full; the cost model's nanoseconds per pyramid built again before a round, "
-           "TestCosts::pyramidNs)";
+           "TestCosts::pyramidNs); submit-tris (full; triangles drawn between two glFlush calls, EngineOptions::submitTriangles, 0 for none)";
 }
 
 Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec) {
@@ -354,6 +356,9 @@ Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec) {
         } else if (param == "pyramid-ns") {
             m.scheduler.mode = CullMode::TwoPhase;
             m.scheduler.tuning.costs.pyramidNs = double(v);
+        } else if (param == "submit-tris") {
+            m.scheduler.mode = CullMode::TwoPhase;
+            m.submitTriangles = v;
         } else if (param == "test-ns") {
             m.scheduler.mode = CullMode::TwoPhase;
             m.scheduler.tuning.costs.testNsPerVolume = double(v);
@@ -528,6 +533,7 @@ Status BenchRunner::runFrame(std::uint64_t frame) {
         const std::size_t m = k == 0 ? 0 : 1 + (k - 1 + turn) % (n - 1);
         const ModeSpec& spec = result_.modes[m];
         engine_.setQueryParams(spec.queries);
+        engine_.setSubmitTriangles(spec.submitTriangles);
         if (schedulers_[m]) schedulers_[m]->setTrace(&trace_);
         engine_.context().clearFramebuffer(Renderer::kClearColour);
         // The reference image is complete even where the scene may skip work (streamed

@@ -42,6 +42,9 @@ struct ModeSpec {
     bool oracleBoxes = false;
     SchedulerParams scheduler;
     GlQueryParams queries;
+    /// The engine's EngineOptions::submitTriangles while this mode renders (shared like
+    /// `queries`, so set before each mode).
+    std::uint32_t submitTriangles = EngineOptions{}.submitTriangles;
     /// The family of settings this mode belongs to, one curve in the speed-accuracy plot:
     /// the approximations it uses (approximationFamily), or for a sweep of a conservative
     /// parameter that parameter's name; empty for a conservative named mode.

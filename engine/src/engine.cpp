@@ -18,7 +18,17 @@ struct Engine::Sink final : PartSink {
     VisibleLists& visible;
     bool marking = false;        // every draw marks one slot (beginDrawMarks)
     bool markingRanges = false;  // every range of drawPartRanges and drawMorePartRanges marks one (beginRangeMarks)
+    std::uint64_t unsubmitted = 0;  // triangles drawn since the last glFlush (EngineOptions::submitTriangles)
+    std::uint32_t submits = 0;
     Sink(Engine& engine, VisibleLists& lists) : e(engine), visible(lists) {}
+    // Hands what is drawn so far to the GPU once enough has piled up; never waits.
+    void drew(std::uint64_t triangles) {
+        unsubmitted += triangles;
+        if (e.submitTriangles_ == 0 || unsubmitted < e.submitTriangles_) return;
+        glFlush();
+        unsubmitted = 0;
+        ++submits;
+    }
     void record(NodeRef part, std::uint32_t firstIndex, std::uint32_t indexCount) {
         const SceneObjects& objs = e.objects_;
         const std::uint32_t object = part.object;
@@ -34,6 +44,7 @@ struct Engine::Sink final : PartSink {
         if (e.callback_) {
             const SceneObjects& objs = e.objects_;
             e.callback_(objs.handle(part.object), objs.modelOf(part.object), firstIndex, indexCount, objs.matrix(part.object));
+            drew(indexCount / 3);
             return;
         }
         const IndexRange range{firstIndex, indexCount};
@@ -71,6 +82,9 @@ struct Engine::Sink final : PartSink {
         else
             e.renderer_->drawRanges(mesh, ranges, objs.matrix(object), colour, markSlot, markEachRange && markSlot != Renderer::kNoMark);
         if (occludee) glDepthMask(GL_TRUE);
+        std::uint64_t triangles = 0;
+        for (const IndexRange& r : ranges) triangles += r.indexCount / 3;
+        drew(triangles);
     }
     bool testsTriangles() const override { return !e.callback_ && e.renderer_ && e.marks_; }
     void beginDrawMarks() override {
@@ -119,7 +133,7 @@ struct Engine::Sink final : PartSink {
 };
 
 Engine::Engine(GlContext& context, const EngineOptions& options)
-    : context_(context), tree_(options.sceneTree), finishEachFrame_(options.finishEachFrame) {
+    : context_(context), tree_(options.sceneTree), finishEachFrame_(options.finishEachFrame), submitTriangles_(options.submitTriangles) {
     View& main = views_.emplace_back();
     main.scheduler = std::make_unique<QueryScheduler>(options.scheduler);
 }
@@ -352,6 +366,7 @@ Expected<FrameStats> Engine::drawFrame(View& view, const char* what, Draw draw) 
     if (renderer_) renderer_->beginFrame(frame);
     Sink sink(*this, view.visible);
     FrameStats st = draw(frame, sink);
+    st.drawSubmits = sink.submits;
     if (renderer_) renderer_->endFrame();
     if (finishEachFrame_) glFinish();
     scope.restore();

@@ -516,6 +516,51 @@ TEST(Embedding, ModelsChangeAndTheViewportResizesBetweenFrames) {
     EXPECT_EQ(ctx->checkErrors(), 0u);
 }
 
+// Drawing handed to the GPU in chunks (EngineOptions::submitTriangles) changes when the
+// GPU starts, never what it draws: after every draw, never, and by the default, the
+// two-phase frames and vfc draw the same images, and a frame counts its submits.
+TEST(Embedding, DrawingSubmittedInChunksDrawsTheSameImage) {
+    auto ctx = test::headless();
+    ASSERT_TRUE(ctx);
+    GameScene scene(*ctx);
+    ASSERT_TRUE(scene.engine);
+    Engine& engine = *scene.engine;
+    EXPECT_EQ(engine.submitTriangles(), EngineOptions{}.submitTriangles);
+    SchedulerParams vfcParams;
+    vfcParams.mode = CullMode::Vfc;
+    QueryScheduler vfc(vfcParams);
+    GameFramebuffer fb;
+    std::vector<float> depth;
+    auto draw = [&](QueryScheduler* s, std::vector<glm::u8vec4>& rgba) -> std::uint32_t {
+        fb.clear();
+        glBindFramebuffer(GL_FRAMEBUFFER, fb.fbo);
+        glViewport(0, 0, kGameW, kGameH);
+        auto st = s ? engine.renderFrame(*s) : engine.renderFrame();
+        EXPECT_TRUE(st.ok()) << st.error().message;
+        fb.read(rgba, depth);
+        return st ? st->drawSubmits : 0u;
+    };
+    std::vector<glm::u8vec4> reference, image;
+    engine.setSubmitTriangles(0);
+    EXPECT_EQ(draw(&vfc, reference), 0u);
+    for (const std::uint32_t every : {0u, 1u, EngineOptions{}.submitTriangles}) {
+        engine.setSubmitTriangles(every);
+        for (int frame = 0; frame < 3; ++frame) {
+            const std::uint32_t submits = draw(nullptr, image);
+            EXPECT_EQ(image, reference) << "every " << every << " triangles, frame " << frame;
+            // Each part drawn is at least one draw (two with cluster history's passes).
+            if (every == 1) {
+                EXPECT_GE(submits, engine.visibleParts().size());
+            } else if (every == 0) {
+                EXPECT_EQ(submits, 0u);
+            }
+        }
+        EXPECT_EQ(draw(&vfc, image), every == 1 ? engine.visibleParts().size() : 0u) << every;
+        EXPECT_EQ(image, reference) << "vfc, every " << every << " triangles";
+    }
+    EXPECT_EQ(ctx->checkErrors(), 0u);
+}
+
 // Objects given by their bounds only: the game draws each whole when dyncull says it is
 // visible. One behind the wall costing a million triangles is tested and culled (the
 // cost model counts what its draw costs, not its box's 12 triangles); one in front is

@@ -29,6 +29,14 @@ struct EngineOptions {
     /// glFinish at the end of every frame, so FrameStats::frameMs bounds the GPU work too
     /// (measurement); off, a frame only submits its work, as a game wants.
     bool finishEachFrame = false;
+    /// Drawing is submitted to the GPU (glFlush) after every this many triangles a frame
+    /// draws (0: only where the frame reads something back, and at its end). A software
+    /// rasteriser such as llvmpipe starts rasterising only at a flush, so without it the
+    /// rasteriser idles while the CPU culls and draws, then the CPU idles at the early
+    /// pass's depth read; a GPU driver flushes its command buffer by itself, and one more
+    /// glFlush per this many triangles costs it little. The default is the measured best
+    /// on llvmpipe (docs/BENCHMARKS.md, sweep parameter submit-tris).
+    std::uint32_t submitTriangles = 4096;
     /// dyncull's own part renderer: addModel uploads each model's split mesh (positions and
     /// normals) to the GPU, and parts are drawn with it unless a draw callback is set. Off,
     /// nothing is uploaded (a game drawing its own buffers keeps one copy) and every frame
@@ -173,6 +181,9 @@ public:
     LooseBspFrameStats updateSceneTree();
     /// See EngineOptions::finishEachFrame.
     void setFinishEachFrame(bool finish) { finishEachFrame_ = finish; }
+    /// See EngineOptions::submitTriangles; takes effect from the next frame.
+    void setSubmitTriangles(std::uint32_t triangles) { submitTriangles_ = triangles; }
+    std::uint32_t submitTriangles() const { return submitTriangles_; }
     /// GL errors the caller had left pending when a dyncull call began (taken off the error
     /// flags so they are not reported as dyncull's; see frame_contract.hpp), since creation.
     std::uint64_t callerGlErrors() const { return callerGlErrors_; }
@@ -252,6 +263,7 @@ private:
     std::vector<std::uint8_t> hasColour_;
     DrawPartCallback callback_;
     bool finishEachFrame_ = false;
+    std::uint32_t submitTriangles_ = 0;
     std::uint64_t callerGlErrors_ = 0;
 };
 

@@ -12,6 +12,9 @@ struct FrameStats {
     double drawMs = 0.0;       ///< CPU time submitting parts (and query volumes)
     double frameMs = 0.0;      ///< whole frame including the final glFinish
     double updateMs = 0.0;     ///< loose-BSP relink and lazy rebuild
+    /// Times the drawing was handed to the GPU during the frame (filled by the engine:
+    /// EngineOptions::submitTriangles), besides the reads that submit it themselves.
+    std::uint32_t drawSubmits = 0;
     std::uint32_t queriesIssued = 0;
     std::uint32_t depthTests = 0;    ///< two-phase: nodes tested against the depth pyramid
     double depthReadMs = 0.0;        ///< two-phase: reading the depth back (waits for the early pass) and building the pyramid
