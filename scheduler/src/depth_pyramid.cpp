@@ -87,9 +87,34 @@ float DepthPyramid::farthestInPixels(int x0, int y0, int x1, int y1, int maxSpan
 bool DepthPyramid::occluded(const ScreenRect& rect, float nearestDepth, int maxSpan) const {
     int x0, y0, x1, y1;
     if (levels_.empty() || !clampRect(rect, width_, height_, x0, y0, x1, y1)) return false;  // no evidence
-    const float farthest = farthestInPixels(x0, y0, x1, y1, maxSpan);
-    // Reversed Z: behind means smaller. Equal or within the slack counts as visible.
-    return nearestDepth < farthest - kDepthSlack * farthest;
+    assert(maxSpan >= 2);
+    // The answer of farthestInPixels at maxSpan, reading fewer texels: hidden behind a
+    // coarser level is hidden behind every finer one (each of its texels is the farthest
+    // of those below it), so a look at the level where the rectangle spans 2 texels
+    // settles most hidden ones; at the finest level the first texel in front settles a
+    // visible one.
+    int fine = 0;
+    while ((x1 >> fine) - (x0 >> fine) >= maxSpan || (y1 >> fine) - (y0 >> fine) >= maxSpan) ++fine;
+    int coarse = fine;
+    while ((x1 >> coarse) - (x0 >> coarse) >= 2 || (y1 >> coarse) - (y0 >> coarse) >= 2) ++coarse;
+    if (coarse > fine && hiddenAt(coarse, x0, y0, x1, y1, nearestDepth)) return true;
+    return hiddenAt(fine, x0, y0, x1, y1, nearestDepth);
+}
+
+bool DepthPyramid::hiddenAt(int level, int x0, int y0, int x1, int y1, float nearestDepth) const {
+    assert(level < levels());
+    const Level& l = levels_[static_cast<std::size_t>(level)];
+    for (int ty = y0 >> level; ty <= (y1 >> level); ++ty) {
+        const float* row = texels_.data() + l.offset + static_cast<std::size_t>(ty) * static_cast<std::size_t>(l.width);
+        for (int tx = x0 >> level; tx <= (x1 >> level); ++tx) {
+            // Reversed Z: behind means smaller. Equal or within the slack counts as visible.
+            // (kDepthSlack is a power of two, so t - kDepthSlack * t rounds monotonically in
+            // t: behind every texel is behind their farthest.)
+            const float t = row[tx];
+            if (!(nearestDepth < t - kDepthSlack * t)) return false;
+        }
+    }
+    return true;
 }
 
 float farthestInBruteForce(std::span<const float> depth, int width, int height, const ScreenRect& rect) {

@@ -91,6 +91,45 @@ TEST(DepthPyramid, NeverNearerThanTheExactFarthestAndExactForSmallRects) {
                 100.0 * static_cast<double>(exact) / static_cast<double>(tests));
 }
 
+// occluded reads a coarse level first and stops at the first texel in front: its answer
+// is still that of every texel at the finest level where the rectangle spans at most
+// `span` texels, read in full (the reference below, from the public texels).
+TEST(DepthPyramid, ShortCutAnswersAsReadingEveryTexelOfTheSpanLevel) {
+    std::mt19937 rng(13);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    std::uint64_t hidden = 0, shown = 0;
+    for (const auto& s : {std::pair{640, 360}, std::pair{257, 129}, std::pair{33, 65}}) {
+        for (const int block : {2, 8, 32}) {
+            const Buffer b = makeBuffer(s.first, s.second, block, rng);
+            DepthPyramid p;
+            p.build(b.depth, b.width, b.height);
+            for (int i = 0; i < 600; ++i) {
+                const ScreenRect r = randomRect(b.width, b.height, rng);
+                const int x0 = std::max(r.x0, 0), y0 = std::max(r.y0, 0);
+                const int x1 = std::min(r.x1, b.width) - 1, y1 = std::min(r.y1, b.height) - 1;
+                if (x0 > x1 || y0 > y1) continue;
+                const float truth = farthestInBruteForce(b.depth, b.width, b.height, r);
+                for (const int span : {2, 4, 16, 32, 64}) {
+                    int k = 0;
+                    while ((x1 >> k) - (x0 >> k) >= span || (y1 >> k) - (y0 >> k) >= span) ++k;
+                    float farthest = 1.0f;
+                    for (int ty = y0 >> k; ty <= (y1 >> k); ++ty)
+                        for (int tx = x0 >> k; tx <= (x1 >> k); ++tx) farthest = std::min(farthest, p.texel(k, tx, ty));
+                    // Depths around the answer's edge, and anywhere.
+                    for (const float z : {u(rng), truth, farthest, farthest * (1.0f - 2.0f * DepthPyramid::kDepthSlack),
+                                          std::nextafter(farthest - DepthPyramid::kDepthSlack * farthest, 0.0f)}) {
+                        const bool expected = z < farthest - DepthPyramid::kDepthSlack * farthest;
+                        ASSERT_EQ(p.occluded(r, z, span), expected) << "span " << span << ", depth " << z;
+                        ++(expected ? hidden : shown);
+                    }
+                }
+            }
+        }
+    }
+    EXPECT_GT(hidden, 1000u);
+    EXPECT_GT(shown, 1000u);
+}
+
 TEST(DepthPyramid, EveryTexelIsTheFarthestOfExactlyItsPixelBlock) {
     std::mt19937 rng(11);
     for (const auto& s : {std::pair{13, 9}, std::pair{640, 360}, std::pair{1, 33}}) {

@@ -65,6 +65,9 @@ public:
 private:
     /// farthestIn for inclusive pixel bounds already clamped to the screen.
     float farthestInPixels(int x0, int y0, int x1, int y1, int maxSpan = kMaxSpan) const;
+    /// Whether a surface at `nearestDepth` lies behind every texel of `level` over the
+    /// clamped pixel bounds (stops at the first it does not).
+    bool hiddenAt(int level, int x0, int y0, int x1, int y1, float nearestDepth) const;
 
     struct Level {
         std::size_t offset = 0;
