@@ -4,7 +4,8 @@
 // is one cluster's whole test as the late pass runs it (cluster_culling.cpp): the normal
 // cone, the box's footprint (ScreenProjection::boxCentres) and the pyramid at span 32, on
 // boxes of 1 to 40 pixels seen through a rotated and scaled object matrix; its parts alone
-// are BM_ClusterCone and BM_ClusterFootprint.
+// are BM_ClusterCone and BM_ClusterFootprint. BM_ClusterRecord is cluster history's record
+// of one cluster at the frame's end.
 #include <benchmark/benchmark.h>
 
 #include <random>
@@ -130,6 +131,23 @@ void BM_ClusterTest(benchmark::State& state) {
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * static_cast<std::int64_t>(s.clusters.size()));
 }
 BENCHMARK(BM_ClusterTest);
+
+// Cluster history's record of one cluster (cluster_history.cpp): the rough float footprint
+// and the pyramid at span 16.
+void BM_ClusterRecord(benchmark::State& state) {
+    const ClusterScene s;
+    const ScreenProjection screen(s.view);
+    const glm::mat4 toClip = screen.clipMatrixOf(s.matrix);
+    std::size_t hidden = 0;
+    ScreenRect centres;
+    float nearest = 0.0f;
+    for (auto _ : state)
+        for (const LeafCluster& c : s.clusters)
+            hidden += screen.roughBoxDepth(toClip, c.box, centres, nearest) && (centres.empty() || s.pyramid.occluded(centres, nearest, 16));
+    benchmark::DoNotOptimize(hidden);
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * static_cast<std::int64_t>(s.clusters.size()));
+}
+BENCHMARK(BM_ClusterRecord);
 
 }  // namespace
 

@@ -118,6 +118,27 @@ TEST(ScreenProjection, BoxDepthFarFromTheOrigin) {
     EXPECT_GT(projected, 100);
 }
 
+// roughBoxDepth, cluster history's guess (float, no rounding margins, corners from the
+// centre and half axes): the exact footprint within a pixel and within float rounding of
+// its depth, wherever the exact path projects the box and no corner is near the eye.
+TEST(ScreenProjection, RoughBoxDepthIsTheExactFootprintWithinRounding) {
+    std::mt19937 rng(17);
+    int compared = 0;
+    for (int i = 0; i < 600; ++i) {
+        const Case c = randomCase(rng, false, i % 2 ? 1.0f : 1e3f);
+        const FrameView view = FrameView::of(c.camera, 640, 360);
+        const ScreenProjection screen(view);
+        ScreenRect exact, rough;
+        float exactNearest = 0.0f, roughNearest = 0.0f;
+        if (!screen.boxCentres(screen.objectProjection(c.matrix), c.box, exact, exactNearest)) continue;
+        ASSERT_TRUE(screen.roughBoxDepth(screen.clipMatrixOf(c.matrix), c.box, rough, roughNearest)) << "case " << i;
+        expectRectNear(rough, exact);
+        EXPECT_NEAR(roughNearest, exactNearest, 1e-5f) << "case " << i;
+        ++compared;
+    }
+    EXPECT_GT(compared, 200);
+}
+
 TEST(ScreenProjection, BoxAroundTheEyeIsVisible) {
     Camera camera;
     camera.position = {0.3f, -0.2f, 0.1f};
