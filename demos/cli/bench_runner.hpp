@@ -176,6 +176,12 @@ struct BenchResult {
     std::vector<LeafVolumeTotals> leafTotals;
     /// Streaming scenes: residency and traffic per frame (all modes of the frame together).
     StreamingSummary streaming;
+    /// Passes over the frames (MeasureOptions::passes): each mode's frame time is its least
+    /// over the passes; everything else is the first pass's.
+    std::uint32_t passes = 1;
+    /// Mode-frames that drew another triangle count in a later pass than in the first
+    /// (decisions that depend on measured times): their least time may be another decision's.
+    std::uint64_t passFramesApart = 0;
 };
 
 /// Borrows the engine (already populated with `scene`) and the scene for its lifetime.
@@ -194,6 +200,10 @@ public:
     void setMeasureVolumeBound(bool on, double budgetPercent = kDefaultBoundBudgetPercent);
     /// Fills result().leafTotals from the scene as it is now (call after the last frame).
     void measureLeafVolumes();
+    /// Takes another pass over the same frames and modes (`other`, from a fresh runner):
+    /// each mode-frame keeps the lesser frame time (FrameStats::frameMs). Preconditions
+    /// (asserted): the same frames and modes.
+    void keepFastest(const BenchResult& other);
 
     const BenchResult& result() const { return result_; }
     /// Image each mode rendered in the last frame (index as result().modes).
@@ -255,6 +265,9 @@ struct MeasureOptions {
     bool quiet = false;  ///< no progress lines on stderr
     bool volumeBound = false;  ///< BenchRunner::setMeasureVolumeBound
     double boundBudgetPercent = kDefaultBoundBudgetPercent;  ///< the cluster bound's error budget, % of the frame's pixels
+    /// Passes over the frames, each from a fresh scene, engine and schedulers: a mode's time
+    /// for a frame is its least over the passes (a quieter figure per frame on a noisy machine).
+    std::uint32_t passes = 1;
 };
 
 /// Creates a headless context and engine, populates the scene, runs `modes` interleaved

@@ -587,6 +587,10 @@ Status writeReport(const BenchResult& r, const std::vector<ModeSummary>& summary
       << "(not counted in any mode)\n"
       << "- modes run interleaved: per frame the scene moves once, then every mode renders that frame with its own "
          "scheduler and history, vfc first (its image is the reference), the others in an order rotated every frame\n";
+    if (r.passes > 1)
+        f << "- times: each mode's least over " << r.passes << " passes of the frames, each from a fresh scene, engine and "
+          << "schedulers (everything else from the first pass); " << r.passFramesApart
+          << " mode-frames drew another triangle count in a later pass\n";
     if (!streaming.empty())
         f << "- geometry streamed (per frame in streaming.csv; all modes of a frame share the caches): `" << streaming
           << "`\n";

@@ -52,6 +52,11 @@ void addMeasureOptions(CLI::App& cmd, MeasureOptions& o, std::string& size, cons
     cmd.add_option("--size", size, "framebuffer size WxH")->capture_default_str();
     cmd.add_option("--out", o.out, "output directory (default " + defaultOut + ")");
     cmd.add_flag("--quiet", o.quiet, "no progress lines");
+    cmd.add_option("--passes", o.passes,
+                   "run the frames this many times, each from a fresh scene, engine and schedulers, and keep each mode's "
+                   "least time per frame (quieter per-frame ratios on a noisy machine)")
+        ->check(wholeIn(1, 100))
+        ->capture_default_str();
     cmd.add_flag("--volume-bound", o.volumeBound,
                  "also query every part's box and auto volume against each frame's final depth (untimed): the parts a "
                  "conservative query-based mode must draw even with perfect order and no history; and every cluster box, with its samples");
