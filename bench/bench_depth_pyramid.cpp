@@ -40,6 +40,19 @@ void BM_DepthPyramidBuild(benchmark::State& state) {
 }
 BENCHMARK(BM_DepthPyramidBuild)->Unit(benchmark::kMicrosecond);
 
+// As the scheduler builds it: the read-back buffer adopted as level 0, no copy.
+void BM_DepthPyramidAdopt(benchmark::State& state) {
+    const int w = 640, h = 360;
+    std::vector<float> depth = depthBuffer(w, h);
+    DepthPyramid p;
+    for (auto _ : state) {
+        p.adopt(depth, w, h);
+        depth.resize(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));  // a read would fill it
+        benchmark::DoNotOptimize(p.texel(p.levels() - 1, 0, 0));
+    }
+}
+BENCHMARK(BM_DepthPyramidAdopt)->Unit(benchmark::kMicrosecond);
+
 void BM_DepthPyramidTest(benchmark::State& state) {
     const int w = 640, h = 360;
     const std::vector<float> depth = depthBuffer(w, h);

@@ -26,31 +26,44 @@ void DepthPyramid::build(std::span<const float> depth, int width, int height) {
     assert(depth.size() == static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
     width_ = width;
     height_ = height;
+    base_.assign(depth.begin(), depth.end());
+    buildLevels();
+}
+
+void DepthPyramid::adopt(std::vector<float>& depth, int width, int height) {
+    assert(width >= 1 && height >= 1);
+    assert(depth.size() == static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
+    width_ = width;
+    height_ = height;
+    base_.swap(depth);
+    buildLevels();
+}
+
+void DepthPyramid::buildLevels() {
     levels_.clear();
+    levels_.push_back({0, width_, height_});
     std::size_t total = 0;
-    for (int w = width, h = height;; w = (w + 1) / 2, h = (h + 1) / 2) {
+    for (int w = width_, h = height_; w > 1 || h > 1;) {
+        w = (w + 1) / 2;
+        h = (h + 1) / 2;
         levels_.push_back({total, w, h});
         total += static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
-        if (w == 1 && h == 1) break;
     }
     texels_.resize(total);
-    std::copy(depth.begin(), depth.end(), texels_.begin());
     for (std::size_t k = 1; k < levels_.size(); ++k) {
         const Level& src = levels_[k - 1];
         const Level& dst = levels_[k];
-        const float* in = texels_.data() + src.offset;
+        const float* in = levelData(k - 1);
         float* out = texels_.data() + dst.offset;
+        const std::size_t sw = static_cast<std::size_t>(src.width), dw = static_cast<std::size_t>(dst.width);
+        const std::size_t pairs = sw / 2;  // texels with both source columns; an odd last one follows
         for (int y = 0; y < dst.height; ++y) {
             // An odd last row or column has no partner: it is its own farthest.
-            const int ya = 2 * y, yb = std::min(2 * y + 1, src.height - 1);
-            for (int x = 0; x < dst.width; ++x) {
-                const int xa = 2 * x, xb = std::min(2 * x + 1, src.width - 1);
-                const std::size_t ra = static_cast<std::size_t>(ya) * static_cast<std::size_t>(src.width);
-                const std::size_t rb = static_cast<std::size_t>(yb) * static_cast<std::size_t>(src.width);
-                out[static_cast<std::size_t>(y) * static_cast<std::size_t>(dst.width) + static_cast<std::size_t>(x)] =
-                    std::min({in[ra + static_cast<std::size_t>(xa)], in[ra + static_cast<std::size_t>(xb)],
-                              in[rb + static_cast<std::size_t>(xa)], in[rb + static_cast<std::size_t>(xb)]});
-            }
+            const float* a = in + static_cast<std::size_t>(2 * y) * sw;
+            const float* b = in + static_cast<std::size_t>(std::min(2 * y + 1, src.height - 1)) * sw;
+            float* o = out + static_cast<std::size_t>(y) * dw;
+            for (std::size_t x = 0; x < pairs; ++x) o[x] = std::min(std::min(a[2 * x], a[2 * x + 1]), std::min(b[2 * x], b[2 * x + 1]));
+            if (pairs < dw) o[pairs] = std::min(a[2 * pairs], b[2 * pairs]);
         }
     }
 }
@@ -59,7 +72,7 @@ float DepthPyramid::texel(int level, int x, int y) const {
     assert(level >= 0 && level < levels());
     const Level& l = levels_[static_cast<std::size_t>(level)];
     assert(x >= 0 && x < l.width && y >= 0 && y < l.height);
-    return texels_[l.offset + static_cast<std::size_t>(y) * static_cast<std::size_t>(l.width) + static_cast<std::size_t>(x)];
+    return levelData(static_cast<std::size_t>(level))[static_cast<std::size_t>(y) * static_cast<std::size_t>(l.width) + static_cast<std::size_t>(x)];
 }
 
 float DepthPyramid::farthestIn(const ScreenRect& rect) const {
@@ -78,7 +91,7 @@ float DepthPyramid::farthestInPixels(int x0, int y0, int x1, int y1, int maxSpan
     const Level& l = levels_[static_cast<std::size_t>(k)];
     float farthest = 1.0f;
     for (int ty = y0 >> k; ty <= (y1 >> k); ++ty) {
-        const float* row = texels_.data() + l.offset + static_cast<std::size_t>(ty) * static_cast<std::size_t>(l.width);
+        const float* row = levelData(static_cast<std::size_t>(k)) + static_cast<std::size_t>(ty) * static_cast<std::size_t>(l.width);
         for (int tx = x0 >> k; tx <= (x1 >> k); ++tx) farthest = std::min(farthest, row[tx]);
     }
     return farthest;
@@ -104,8 +117,9 @@ bool DepthPyramid::occluded(const ScreenRect& rect, float nearestDepth, int maxS
 bool DepthPyramid::hiddenAt(int level, int x0, int y0, int x1, int y1, float nearestDepth) const {
     assert(level < levels());
     const Level& l = levels_[static_cast<std::size_t>(level)];
+    const float* data = levelData(static_cast<std::size_t>(level));
     for (int ty = y0 >> level; ty <= (y1 >> level); ++ty) {
-        const float* row = texels_.data() + l.offset + static_cast<std::size_t>(ty) * static_cast<std::size_t>(l.width);
+        const float* row = data + static_cast<std::size_t>(ty) * static_cast<std::size_t>(l.width);
         for (int tx = x0 >> level; tx <= (x1 >> level); ++tx) {
             // Reversed Z: behind means smaller. Equal or within the slack counts as visible.
             // (kDepthSlack is a power of two, so t - kDepthSlack * t rounds monotonically in

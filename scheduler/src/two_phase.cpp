@@ -126,7 +126,7 @@ bool QueryScheduler::buildPyramid(Frame& f) {
     splitDrawWait(f);
     int w = 0, h = 0;
     const bool haveDepth = f.backend.readDepth(depth_, w, h) && w == f.view.width && h == f.view.height;
-    if (haveDepth) pyramid_.build(depth_, w, h);
+    if (haveDepth) pyramid_.adopt(depth_, w, h);  // depth_ gets the old level 0 back for the next read
     f.stats.pyramidBuilds += haveDepth;
     pyramidView_.reset();
     if (haveDepth) pyramidView_ = f.view;

@@ -130,6 +130,26 @@ TEST(DepthPyramid, ShortCutAnswersAsReadingEveryTexelOfTheSpanLevel) {
     EXPECT_GT(shown, 1000u);
 }
 
+// adopt builds the pyramid build does, from the caller's buffer without a copy, and hands
+// back a buffer of its own; a pyramid rebuilt at another size is that size's throughout.
+TEST(DepthPyramid, AdoptingTheBufferBuildsTheSamePyramid) {
+    std::mt19937 rng(19);
+    DepthPyramid adopted;
+    for (const auto& s : {std::pair{640, 360}, std::pair{1, 1}, std::pair{7, 1}, std::pair{33, 65}, std::pair{640, 360}}) {
+        const Buffer b = makeBuffer(s.first, s.second, 4, rng);
+        DepthPyramid copied;
+        copied.build(b.depth, b.width, b.height);
+        std::vector<float> buffer = b.depth;
+        adopted.adopt(buffer, b.width, b.height);
+        ASSERT_EQ(adopted.levels(), copied.levels());
+        for (int k = 0; k < copied.levels(); ++k) {
+            const int w = std::max(1, (b.width + (1 << k) - 1) >> k), h = std::max(1, (b.height + (1 << k) - 1) >> k);
+            for (int y = 0; y < h; ++y)
+                for (int x = 0; x < w; ++x) ASSERT_EQ(adopted.texel(k, x, y), copied.texel(k, x, y)) << "level " << k;
+        }
+    }
+}
+
 TEST(DepthPyramid, EveryTexelIsTheFarthestOfExactlyItsPixelBlock) {
     std::mt19937 rng(11);
     for (const auto& s : {std::pair{13, 9}, std::pair{640, 360}, std::pair{1, 33}}) {

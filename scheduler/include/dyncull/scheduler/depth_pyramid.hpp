@@ -28,6 +28,10 @@ public:
     /// bottom row (as glReadPixels returns them). Reuses its memory across calls.
     /// Preconditions (asserted): width, height >= 1, depth.size() == width * height.
     void build(std::span<const float> depth, int width, int height);
+    /// The same without copying the depth buffer: level 0 becomes `depth`'s storage, and
+    /// `depth` gets the storage level 0 had (its contents unspecified), for the next read.
+    /// Preconditions as build.
+    void adopt(std::vector<float>& depth, int width, int height);
 
     int width() const { return width_; }
     int height() const { return height_; }
@@ -69,11 +73,17 @@ private:
     /// clamped pixel bounds (stops at the first it does not).
     bool hiddenAt(int level, int x0, int y0, int x1, int y1, float nearestDepth) const;
 
+    /// Builds levels 1 and up from base_.
+    void buildLevels();
+    /// Level `k`'s texels, row-major from the bottom row.
+    const float* levelData(std::size_t k) const { return k == 0 ? base_.data() : texels_.data() + levels_[k].offset; }
+
     struct Level {
-        std::size_t offset = 0;
+        std::size_t offset = 0;  // into texels_ (levels 1 and up)
         int width = 0, height = 0;
     };
-    std::vector<float> texels_;  // every level, level 0 first, each row-major from the bottom row
+    std::vector<float> base_;    // level 0: the depth buffer
+    std::vector<float> texels_;  // levels 1 and up, each row-major from the bottom row
     std::vector<Level> levels_;
     int width_ = 0, height_ = 0;
 };
