@@ -140,6 +140,11 @@ ObjectProjection ScreenProjection::objectProjection(const glm::mat4& matrix) con
     const double det = std::abs(glm::dot(c0, glm::cross(c1, c2)));
     const double a0 = glm::length(glm::cross(c1, c2)), a1 = glm::length(glm::cross(c2, c0)), a2 = glm::length(glm::cross(c0, c1));
     p.faceScale = {a0 > 0.0 ? det / a0 : 0.0, a1 > 0.0 ? det / a1 : 0.0, a2 > 0.0 ? det / a2 : 0.0};
+    glm::dmat4 relative = p.toWorld;
+    relative[3] -= glm::dvec4(glm::dvec3(view_.camera.position), 0.0);  // world minus the eye
+    p.toClip = view_.viewProjRelative * relative;
+    for (int j = 0; j < 4; ++j) p.toDistance[j] = glm::dot(distanceRow_, relative[j]);
+    p.absLinear = glm::dmat3(glm::abs(c0), glm::abs(c1), glm::abs(c2));
     return p;
 }
 
@@ -148,12 +153,11 @@ ScreenProjection::BoxNdc ScreenProjection::boxNdc(const ObjectProjection& object
     // QueryVolume::enlargedForRounding for a box: its vertices' magnitude sets the margin,
     // and each face is pushed out by it through a scale about the centre by k.
     const glm::dvec3 lo(local.min), hi(local.max);
-    const glm::dvec4 centre(0.5 * (lo + hi), 1.0);
+    const glm::dvec3 centre = 0.5 * (lo + hi);
     const glm::dvec3 half = 0.5 * (hi - lo);
-    const glm::dvec3 worldCentre(object.toWorld * centre);
-    const glm::dvec3 axis[3] = {glm::dvec3(object.toWorld[0]) * half.x, glm::dvec3(object.toWorld[1]) * half.y,
-                                glm::dvec3(object.toWorld[2]) * half.z};
-    const glm::dvec3 reach = glm::abs(worldCentre) + glm::abs(axis[0]) + glm::abs(axis[1]) + glm::abs(axis[2]);
+    const glm::dvec3 worldCentre = glm::dvec3(object.toWorld[3]) + glm::dmat3(object.toWorld) * centre;
+    const glm::dvec3 axesReach = object.absLinear * half;  // sum over the half axes of |toWorld axis * half|
+    const glm::dvec3 reach = glm::abs(worldCentre) + axesReach;
     const double magnitude = std::max({reach.x, reach.y, reach.z});  // of the farthest corner, per coordinate
     const double push = magnitude * 0x1p-22 * std::sqrt(3.0);
     const double nearest = std::min({half.x * object.faceScale.x, half.y * object.faceScale.y, half.z * object.faceScale.z});
@@ -161,23 +165,18 @@ ScreenProjection::BoxNdc ScreenProjection::boxNdc(const ObjectProjection& object
     const double k = 1.0 + push / nearest;
     // The corners are the centre plus or minus each scaled axis, and the projection is
     // linear: the centre and the three axes are projected once, the corners summed in clip
-    // space (what pointsDepth does per corner, in a third of the arithmetic).
+    // space (what pointsDepth does per corner, in a fraction of the arithmetic).
     const glm::dvec3 relCentre = worldCentre - glm::dvec3(view_.camera.position);
-    const glm::dvec3 a0 = k * axis[0], a1 = k * axis[1], a2 = k * axis[2];
-    const glm::dvec3 spread = glm::abs(a0) + glm::abs(a1) + glm::abs(a2);
     // The largest coordinate of any corner: per axis the centre's plus the spread, exactly
     // as the corners' (the sign pattern that reaches it is one of the eight).
-    const glm::dvec3 far = glm::abs(relCentre) + spread;
+    const glm::dvec3 far = glm::abs(relCentre) + k * axesReach;
     const double nearPlane = double(view_.camera.nearPlane);
     const double nearTest = nearPlane + 0x1p-21 * std::max({far.x, far.y, far.z}) + 0x1p-22 * nearPlane;
-    const glm::dmat4& m = view_.viewProjRelative;
-    const glm::dvec4 c = m * glm::dvec4(relCentre, 1.0);
-    const glm::dvec4 p0 = m * glm::dvec4(a0, 0.0), p1 = m * glm::dvec4(a1, 0.0), p2 = m * glm::dvec4(a2, 0.0);
-    const bool ortho = view_.camera.orthographic();
-    const double dc = ortho ? glm::dot(distanceRow_, glm::dvec4(relCentre, 1.0)) : c.w;
-    const double d0 = ortho ? glm::dot(distanceRow_, glm::dvec4(a0, 0.0)) : p0.w;
-    const double d1 = ortho ? glm::dot(distanceRow_, glm::dvec4(a1, 0.0)) : p1.w;
-    const double d2 = ortho ? glm::dot(distanceRow_, glm::dvec4(a2, 0.0)) : p2.w;
+    const glm::dvec4 c = object.toClip * glm::dvec4(centre, 1.0);
+    const glm::dvec3 scaled = k * half;
+    const glm::dvec4 p0 = object.toClip[0] * scaled.x, p1 = object.toClip[1] * scaled.y, p2 = object.toClip[2] * scaled.z;
+    const double dc = glm::dot(object.toDistance, glm::dvec4(centre, 1.0));
+    const double d0 = object.toDistance.x * scaled.x, d1 = object.toDistance.y * scaled.y, d2 = object.toDistance.z * scaled.z;
     // The nearest corner along the view decides the near test for all eight.
     if (dc - std::abs(d0) - std::abs(d1) - std::abs(d2) < nearTest) return BoxNdc::Crossing;
     ndcLo = glm::dvec2(1e300);

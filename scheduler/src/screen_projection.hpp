@@ -33,6 +33,13 @@ struct ObjectProjection {
     /// per unit of the box's half extent along i (|det| / |column j x column k| of the
     /// matrix's linear part); 0 for a singular matrix.
     glm::dvec3 faceScale{0.0};
+    /// Object space to clip space through the camera-relative view-projection, and to the
+    /// distance along the view direction (clip w in perspective): a box's centre and half
+    /// axes are projected by one product and three column scalings.
+    glm::dmat4 toClip{1.0};
+    glm::dvec4 toDistance{0.0};
+    /// |toWorld|'s linear columns: a box's half axes' summed reach per world axis.
+    glm::dmat3 absLinear{0.0};
 };
 
 /// Projects world-space boxes and volumes into one frame's viewport (pixels, origin at the
