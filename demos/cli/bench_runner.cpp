@@ -309,7 +309,7 @@ std::string sweepParamsHelp() {
            "latency (0 or 1 frames); error-budget (full; percent of the frame's pixels, decimals allowed); pyramid-span (full; "
            "texels a side of the late pass's pyramid tests, 2 to 64); cluster-span (full; the same for cluster tests); candidate-rounds (full; rounds of the late pass's raster tests, 1 to 16); test-ns (full; the cost model's nanoseconds per batched volume "
            "test, TestCosts::testNsPerVolume); pyramid-ns (full; the cost model's nanoseconds per pyramid built again before a round, "
-           "TestCosts::pyramidNs); submit-tris (full; triangles drawn between two glFlush calls, EngineOptions::submitTriangles, 0 for none)";
+           "TestCosts::pyramidNs); record-worker (full; clusters from which cluster history's frame-end record shares its tests with a second thread, SchedulerTuning::recordWorkerClusters); submit-tris (full; triangles drawn between two glFlush calls, EngineOptions::submitTriangles, 0 for none)";
 }
 
 Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec) {
@@ -356,6 +356,9 @@ Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec) {
         } else if (param == "pyramid-ns") {
             m.scheduler.mode = CullMode::TwoPhase;
             m.scheduler.tuning.costs.pyramidNs = double(v);
+        } else if (param == "record-worker") {
+            m.scheduler.mode = CullMode::TwoPhase;
+            m.scheduler.tuning.recordWorkerClusters = v;
         } else if (param == "submit-tris") {
             m.scheduler.mode = CullMode::TwoPhase;
             m.submitTriangles = v;

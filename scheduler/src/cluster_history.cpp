@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cassert>
 #include <system_error>
+#include <thread>
 
 #include "cluster_selection.hpp"
 
@@ -102,26 +103,27 @@ void QueryScheduler::drawDeferredClusters(Frame& f) {
     }
 }
 
-void QueryScheduler::recordClusterVisibility(Frame& f) {
-    // The final depth holds every occluder the frame drew, so it hides the most clusters;
-    // what it says only chooses next frame's early draws.
-    if (!buildPyramid(f)) return;  // the bits stay as they were
-    const auto t1 = SchedulerClock::now();
+namespace {
+std::span<const LeafCluster> partClusters(const SceneObjects& objs, NodeRef ref) {
+    const LocalBsp& model = objs.model(objs.modelOf(ref.object));
+    return model.clusters.ofSubtree(ref.node, model.nodes[ref.node].subtreeSize);
+}
+}  // namespace
+
+void QueryScheduler::recordVerdicts(const Frame& f, std::span<const NodeRef> parts, bool sinkCullsBackFaces,
+                                    std::vector<std::uint8_t>& shown) const {
     const SceneObjects& objs = f.objects;
-    for (const NodeRef ref : clusterParts_) {
+    shown.clear();
+    for (const NodeRef ref : parts) {
         const LocalBsp& model = objs.model(objs.modelOf(ref.object));
-        const std::span<const LeafCluster> clusters = model.clusters.ofSubtree(ref.node, model.nodes[ref.node].subtreeSize);
-        const std::span<std::uint64_t> bits = history_.clusterBits(ref.object, objs);
-        const std::uint32_t first = model.clusters.nodeFirst[ref.node];
+        const std::span<const LeafCluster> clusters = partClusters(objs, ref);
         const glm::mat4& matrix = objs.matrix(ref.object);
         const glm::mat4 toClip = f.screen.clipMatrixOf(matrix);
         // A cluster facing away now is left to next frame's late pass, should it turn: the
         // cone test is cheaper than the projection.
-        const bool cones = model.faces == FaceMode::CullBack && f.sink.cullsBackFaces();
+        const bool cones = model.faces == FaceMode::CullBack && sinkCullsBackFaces;
         const ObjectSpaceEye eye(f.camera(), matrix);
-        for (std::uint32_t i = 0; i < clusters.size(); ++i) {
-            const std::uint32_t k = first + i;
-            const LeafCluster& c = clusters[i];
+        for (const LeafCluster& c : clusters) {
             // No guarantee needed here (a deferred cluster is tested in the late pass), so
             // the box is projected roughly: in float, without rounding margins.
             ScreenRect centres;
@@ -129,9 +131,57 @@ void QueryScheduler::recordClusterVisibility(Frame& f) {
             const bool hidden = (cones && eye.backFacing(c)) ||
                                 (f.screen.roughBoxDepth(toClip, c.box, centres, nearest) &&
                                  (centres.empty() || pyramid_.occluded(centres, nearest, kRecordSpan)));
-            setClusterBit(bits, k, !hidden);
+            shown.push_back(hidden ? 0 : 1);
         }
     }
+}
+
+void QueryScheduler::recordClusterVisibility(Frame& f) {
+    // The final depth holds every occluder the frame drew, so it hides the most clusters;
+    // what it says only chooses next frame's early draws.
+    if (!buildPyramid(f)) return;  // the bits stay as they were
+    const auto t1 = SchedulerClock::now();
+    const SceneObjects& objs = f.objects;
+    // All drawing is done, so the rasteriser's cores are free: with the worker, the later
+    // parts (about half the clusters) are tested on a second thread. Each half writes its
+    // own verdicts; the bits are set after the join, since two parts of one object may
+    // share a word of them.
+    std::size_t split = clusterParts_.size();
+    if (params_.features.useClusterWorker) {
+        std::size_t total = 0;
+        for (const NodeRef ref : clusterParts_) total += partClusters(objs, ref).size();
+        if (total >= params_.tuning.recordWorkerClusters) {
+            std::size_t half = 0;
+            split = 0;
+            while (split < clusterParts_.size() && 2 * half < total) half += partClusters(objs, clusterParts_[split++]).size();
+        }
+    }
+    const std::span<const NodeRef> parts(clusterParts_);
+    const bool cullsBackFaces = f.sink.cullsBackFaces();
+    std::thread worker;
+    if (split < clusterParts_.size()) {
+        try {
+            worker = std::thread([this, &f, parts, split, cullsBackFaces] {
+                recordVerdicts(f, parts.subspan(split), cullsBackFaces, recordShownLate_);
+            });
+        } catch (const std::system_error&) {
+            split = clusterParts_.size();  // no thread to be had: all on this one
+        }
+    }
+    recordVerdicts(f, parts.first(split), cullsBackFaces, recordShown_);
+    if (worker.joinable()) {
+        worker.join();
+        recordShown_.insert(recordShown_.end(), recordShownLate_.begin(), recordShownLate_.end());
+    }
+    std::size_t next = 0;
+    for (const NodeRef ref : clusterParts_) {
+        const std::size_t count = partClusters(objs, ref).size();
+        const std::span<std::uint64_t> bits = history_.clusterBits(ref.object, objs);
+        const std::uint32_t first = objs.model(objs.modelOf(ref.object)).clusters.nodeFirst[ref.node];
+        for (std::size_t i = 0; i < count; ++i) setClusterBit(bits, first + static_cast<std::uint32_t>(i), recordShown_[next + i] != 0);
+        next += count;
+    }
+    assert(next == recordShown_.size());
     f.stats.clusterMs += msSince(t1);
     // Its price for the cost model: the tests, and a read that waits for nothing plus the
     // build. The wait for the frame's drawing is the drawing's, due by the frame's end

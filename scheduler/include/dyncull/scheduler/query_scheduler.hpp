@@ -112,8 +112,9 @@ struct SchedulerFeatures {
     bool useClusterMarks = false;
     /// TwoPhase with cluster history: the late pass's deferred clusters are tested on a
     /// worker thread while the render thread runs the late traversal and its draws (they
-    /// depend only on the early pyramid), instead of part by part as they are drawn. The
-    /// same decisions either way; off: on the render thread (the reference).
+    /// depend only on the early pyramid), instead of part by part as they are drawn; and
+    /// the frame-end record's tests are shared with a second thread. The same decisions
+    /// either way; off: on the render thread (the reference).
     bool useClusterWorker = true;
     /// TwoPhase with clusters: before the parts a round of raster tests let through are
     /// drawn, the pyramid is built again from the depth drawn so far (which that round's
@@ -266,6 +267,10 @@ struct SchedulerTuning {
     /// (FrameStats::drawWaitMs, pyramidTestMs). Both waits happen anyway inside the read and
     /// the test; splitting them off costs a sync only where the backend would overlap.
     bool splitDrawWaits = false;
+    /// With useClusterWorker: cluster history's record at the frame's end shares its tests
+    /// with a second thread from this many clusters (a thread costs tens of microseconds to
+    /// start).
+    std::uint32_t recordWorkerClusters = 4096;
     TestCosts costs;
 };
 
@@ -602,8 +607,13 @@ private:
     /// cannot reject, drawn.
     void drawDeferredClusters(Frame& f);
     /// At the frame's end: the final depth read back into the pyramid and every cluster of
-    /// clusterParts_ tested against it, into the parts' cluster bits.
+    /// clusterParts_ tested against it, into the parts' cluster bits (with
+    /// useClusterWorker, the later half of the clusters on a second thread).
     void recordClusterVisibility(Frame& f);
+    /// The record's verdicts for `parts`' clusters in order, 1 where a cluster shows: reads
+    /// only the frame, the pyramid and the objects, so two threads can share the parts.
+    void recordVerdicts(const Frame& f, std::span<const NodeRef> parts, bool sinkCullsBackFaces, std::vector<std::uint8_t>& shown) const;
+    std::vector<std::uint8_t> recordShown_, recordShownLate_;
     // useClusterMarks: the cluster each range of clusterRanges_ is (its index in its
     // model's clusters), and every cluster drawn this frame in the order its mark comes back.
     struct MarkedCluster {
