@@ -33,9 +33,10 @@ struct EngineOptions {
     /// draws (0: only where the frame reads something back, and at its end). A software
     /// rasteriser such as llvmpipe starts rasterising only at a flush, so without it the
     /// rasteriser idles while the CPU culls and draws, then the CPU idles at the early
-    /// pass's depth read; a GPU driver flushes its command buffer by itself, and one more
-    /// glFlush per this many triangles costs it little. The default is the measured best
-    /// on llvmpipe (docs/BENCHMARKS.md, sweep parameter submit-tris).
+    /// pass's depth read. The default is the measured best on llvmpipe (docs/BENCHMARKS.md,
+    /// sweep parameter submit-tris). A hardware driver flushes its command buffer by itself
+    /// and each glFlush is a submission with its own CPU cost, which was not measured here:
+    /// there, start from 0 or a far larger interval.
     std::uint32_t submitTriangles = 4096;
     /// dyncull's own part renderer: addModel uploads each model's split mesh (positions and
     /// normals) to the GPU, and parts are drawn with it unless a draw callback is set. Off,
