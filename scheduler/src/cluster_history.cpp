@@ -206,7 +206,7 @@ void QueryScheduler::readClusterMarks(Frame& f) {
         const LocalBsp& model = objs.model(objs.modelOf(ref.object));
         const std::span<std::uint64_t> bits = history_.clusterBits(ref.object, objs);
         const std::uint32_t first = model.clusters.nodeFirst[ref.node];
-        const std::uint32_t end = first + static_cast<std::uint32_t>(model.clusters.ofSubtree(ref.node, model.nodes[ref.node].subtreeSize).size());
+        const std::uint32_t end = first + static_cast<std::uint32_t>(partClusters(objs, ref).size());
         for (std::uint32_t k = first; k < end; ++k) setClusterBit(bits, k, false);
     }
     // Marks come back part by part: the object's bits are looked up once per run.

@@ -82,11 +82,9 @@ float DepthPyramid::farthestIn(const ScreenRect& rect) const {
 }
 
 float DepthPyramid::farthestInPixels(int x0, int y0, int x1, int y1, int maxSpan) const {
-    // The finest level where the rectangle spans at most maxSpan texels on both axes (at
-    // the top level, 1x1, it always does); every texel it touches there is read.
+    // Every texel the rectangle touches at that level is read.
     assert(maxSpan >= 2);
-    int k = 0;
-    while ((x1 >> k) - (x0 >> k) >= maxSpan || (y1 >> k) - (y0 >> k) >= maxSpan) ++k;
+    const int k = levelSpanning(x0, y0, x1, y1, maxSpan);
     assert(k < levels());
     const Level& l = levels_[static_cast<std::size_t>(k)];
     float farthest = 1.0f;
@@ -106,10 +104,8 @@ bool DepthPyramid::occluded(const ScreenRect& rect, float nearestDepth, int maxS
     // of those below it), so a look at the level where the rectangle spans 2 texels
     // settles most hidden ones; at the finest level the first texel in front settles a
     // visible one.
-    int fine = 0;
-    while ((x1 >> fine) - (x0 >> fine) >= maxSpan || (y1 >> fine) - (y0 >> fine) >= maxSpan) ++fine;
-    int coarse = fine;
-    while ((x1 >> coarse) - (x0 >> coarse) >= 2 || (y1 >> coarse) - (y0 >> coarse) >= 2) ++coarse;
+    const int fine = levelSpanning(x0, y0, x1, y1, maxSpan);
+    const int coarse = levelSpanning(x0, y0, x1, y1, 2, fine);
     if (coarse > fine && hiddenAt(coarse, x0, y0, x1, y1, nearestDepth)) return true;
     return hiddenAt(fine, x0, y0, x1, y1, nearestDepth);
 }

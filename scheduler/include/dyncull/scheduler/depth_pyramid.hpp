@@ -67,6 +67,14 @@ public:
     static constexpr float kDepthSlack = 0x1p-16f;
 
 private:
+    /// The finest level where inclusive pixel bounds span at most `maxSpan` texels a side,
+    /// looking from level `from` up (a level where they span at most more texels).
+    /// (At the top level, 1x1, any rectangle spans one texel.)
+    static int levelSpanning(int x0, int y0, int x1, int y1, int maxSpan, int from = 0) {
+        int k = from;
+        while ((x1 >> k) - (x0 >> k) >= maxSpan || (y1 >> k) - (y0 >> k) >= maxSpan) ++k;
+        return k;
+    }
     /// farthestIn for inclusive pixel bounds already clamped to the screen.
     float farthestInPixels(int x0, int y0, int x1, int y1, int maxSpan = kMaxSpan) const;
     /// Whether a surface at `nearestDepth` lies behind every texel of `level` over the
