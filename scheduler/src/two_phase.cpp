@@ -63,8 +63,15 @@ void QueryScheduler::runTwoPhase(Frame& f) {
     markedClusters_.clear();
     if (f.markClusters) f.sink.beginRangeMarks();
 
-    // 1. Early pass.
-    const bool drewEarly = drawEarlySet(f);
+    // 1. Early pass, in a frame that tests. A frame that does not has one traversal, which
+    // draws everything front to back as vfc does: last frame's parts drawn first would
+    // change only the order, and a worse order costs overdraw.
+    bool drewEarly = false;
+    if (testing) {
+        drewEarly = drawEarlySet(f);
+    } else {
+        active_.clear();
+    }
 
     // 2. The early pass's depth, unless this frame does not test. A backend that cannot
     // read depth leaves the pyramid unbuilt, and an unbuilt pyramid calls nothing occluded.

@@ -83,7 +83,11 @@ SchedulerParams queriesParams() {
 
 struct RecordingSink final : PartSink {
     std::multiset<std::uint32_t> drawn;
-    void drawPart(NodeRef part, std::uint32_t, std::uint32_t) override { drawn.insert(part.object); }
+    std::vector<NodeRef> order;  ///< the parts in the order they were drawn
+    void drawPart(NodeRef part, std::uint32_t, std::uint32_t) override {
+        drawn.insert(part.object);
+        order.push_back(part);
+    }
 };
 
 // Answers by a rule after `latency` polls; can also never answer.
@@ -1190,6 +1194,35 @@ TEST(TwoPhaseCosts, TestsStopWhereTheyCullNothingAndResumeWhenTheyWould) {
         always.cullFrame(tree, frontCamera(), 640, 320, b2, sink);
     }
     EXPECT_EQ(b2.reads, 5);
+}
+
+// A frame that the cost model does not test has one traversal, front to back like vfc's.
+// Drawing last frame's parts first would change only the order, and a worse order costs
+// overdraw. The camera steps sideways each frame, so last frame's parts are not this one's.
+TEST(TwoPhaseCosts, AFrameThatDoesNotTestDrawsInVfcsOrder) {
+    TestScene s(6, 4);
+    TwoLevelTree tree(s.bsp, s.objects);
+    SchedulerParams vfc;
+    vfc.mode = CullMode::Vfc;
+    SchedulerParams p = twoPhase();
+    p.tuning.costs.probeFrames = 1000;
+    p.tuning.costs.depthReadNs = 1e12;  // no saving pays for a depth read
+    QueryScheduler sched(p), reference(vfc);
+    DepthBackend backend;
+    ScriptedBackend none;
+    int untested = 0;
+    for (int f = 0; f < 6; ++f) {
+        Camera cam = frontCamera();
+        cam.position.x = cam.target.x = (f % 2 ? 2.5f : -2.5f);
+        RecordingSink sink, expected;
+        const int reads = backend.reads;
+        sched.cullFrame(tree, cam, 640, 320, backend, sink);
+        reference.cullFrame(tree, cam, 640, 320, none, expected);
+        if (backend.reads > reads) continue;  // a frame that tests (the first)
+        ++untested;
+        EXPECT_EQ(sink.order, expected.order) << "frame " << f;
+    }
+    EXPECT_GE(untested, 5);
 }
 
 // A part is tested only if the drawing it may save outweighs the test: with drawing free,
