@@ -41,6 +41,9 @@ struct QueryScheduler::Frame {
     /// Recording cluster bits from the sink's range marks (SchedulerFeatures::useClusterMarks):
     /// every part drawn as clusters is drawn one range per cluster, each marked.
     bool markClusters = false;
+    /// TwoPhase, the cost model's probe in a frame that does not test: every part drawn
+    /// (but those certainly visible) is tested against the final depth at the frame's end.
+    bool probeAtEnd = false;
 
     const Camera& camera() const { return view.camera; }
     const Frustum& frustum() const { return view.frustum; }

@@ -43,10 +43,17 @@ void QueryScheduler::runTwoPhase(Frame& f) {
         f.marking = true;
     }
 
-    // Unless the cost model turns this frame's tests off, its early parts draw only the
-    // clusters that showed last frame (cluster history).
-    const bool testing = !params_.features.useCostModel || savedNs_ > params_.tuning.costs.depthReadNs ||
-                         f.index - lastTestedFrame_ >= params_.tuning.costs.probeFrames;
+    // The cost model may turn this frame's tests off. Every probeFrames frames it probes
+    // whether they would pay again: at the frame's end, testing every part drawn against
+    // a pyramid of the final depth (probeFinalDepth: a depth read that waits for nothing
+    // the frame's end does not wait for, and no early pass's stall); or, where the sink
+    // tests triangles, with a frame that tests.
+    const bool pays = !params_.features.useCostModel || savedNs_ > params_.tuning.costs.depthReadNs;
+    const bool probeDue = !pays && f.index - lastTestedFrame_ >= params_.tuning.costs.probeFrames;
+    f.probeAtEnd = probeDue && params_.features.useEndProbes && !triangles;
+    const bool testing = pays || (probeDue && !f.probeAtEnd);
+    // Unless this frame does not test, its early parts draw only the clusters that showed
+    // last frame (cluster history).
     deferredParts_.clear();
     clusterParts_.clear();
     deferredTriangles_ = 0;
@@ -106,7 +113,11 @@ void QueryScheduler::runTwoPhase(Frame& f) {
     if (!candidates_.empty()) testCandidates(f, triangles);
     if (!triangleTests_.empty()) testTriangles(f);
     if (triangles) readDrawMarks(f);
-    if (!refresh_.empty()) testRefresh(f);
+    if (f.probeAtEnd) {
+        probeFinalDepth(f);
+    } else if (!refresh_.empty()) {
+        testRefresh(f);
+    }
     if (f.markClusters) {
         readClusterMarks(f);  // also ends the sink's marking
     } else if (f.recordClusterBits && !clusterParts_.empty()) {
@@ -115,7 +126,7 @@ void QueryScheduler::runTwoPhase(Frame& f) {
     // A frame with no early depth (the first, or after everything turned hidden) had
     // nothing to test the pyramid against, so only the final-depth tests measured what
     // testing saves; without them the frame says nothing and the estimate stands.
-    if (testing && (drewEarly || !refresh_.empty() || triangles)) {
+    if ((testing && (drewEarly || !refresh_.empty() || triangles)) || f.probeAtEnd) {
         lastTestedFrame_ = f.index;
         savedNs_ = double(culledTriangles_) * params_.tuning.costs.drawNsPerTriangle;
     }
@@ -243,6 +254,7 @@ void QueryScheduler::lateTraversal(Frame& f, bool testing, bool haveDepth, bool 
             if (raster && !certain) ++f.stats.skippedByCost;
             note(certain ? NodeState::VisibleNear : testing && !raster ? NodeState::VisibleQueried : NodeState::VisibleCheaper);
             drawNode(f, ref, false);
+            if (f.probeAtEnd && !certain) refresh_.push_back(ref);
         }
     }
 
@@ -361,6 +373,22 @@ void QueryScheduler::testRefresh(Frame& f) {
                              !(budget && rasterSamples_[i] != kUnknownSamples && rasterSamples_[i] <= budgetPixels);
         if (!visible) culledTriangles_ += subtreeTriangles(f, refresh_[i]);  // not drawn early next frame
         history_.recordAnswer(history_.at(refresh_[i], objs), visible, f.index);
+    }
+}
+
+void QueryScheduler::probeFinalDepth(Frame& f) {
+    // A part drawn whose volume is behind the final depth would have been culled by a
+    // frame that tests (or left its early set): what testing would save, as the late
+    // pass's first test measures it. Its own fragments are in that depth, never behind
+    // its volume's nearest point, so a part that shows is never called hidden.
+    if (refresh_.empty() || !buildPyramid(f)) return;
+    for (const NodeRef ref : refresh_) {
+        DepthFootprint fp;
+        ++f.stats.depthTests;
+        const bool hidden = testedFootprint(f, ref, fp) && !fp.rect.empty() &&
+                            (fp.centres.empty() || pyramid_.occluded(fp.centres, fp.nearest, params_.tuning.pyramidSpan));
+        if (hidden) culledTriangles_ += subtreeTriangles(f, ref);
+        history_.recordAnswer(history_.at(ref, f.objects), !hidden, f.index);
     }
 }
 

@@ -51,6 +51,10 @@ TEST(BenchModes, AblationsOfFullAndTheirVolumes) {
     EXPECT_TRUE(modeFromName("vfc")->scheduler.features.useClusters);
     EXPECT_FALSE(modeFromName("vfc-noclusters")->scheduler.features.useClusters);
     EXPECT_EQ(modeFromName("vfc-noclusters")->scheduler.mode, CullMode::Vfc);
+    EXPECT_EQ(modeFromName("vfc-again")->scheduler.mode, CullMode::Vfc);  // the noise floor: vfc again
+    EXPECT_TRUE(modeFromName("vfc-again")->scheduler.features.useClusters);
+    EXPECT_TRUE(modeFromName("full")->scheduler.features.useEndProbes);
+    EXPECT_FALSE(modeFromName("full-testprobe")->scheduler.features.useEndProbes);
     const ModeSpec k = modeFromName("full+kdop26").take();
     EXPECT_EQ(k.scheduler.mode, CullMode::TwoPhase);
     EXPECT_EQ(k.scheduler.tuning.volume, VolumeChoice::Kdop26);

@@ -989,6 +989,7 @@ struct DepthBackend final : QueryBackend {
     std::function<QueryResult(const QueryVolume&)> rule = [](const QueryVolume&) { return QueryResult::Visible; };
     int reads = 0, tested = 0, batches = 0, finishes = 0;
     std::vector<std::vector<QueryResult>> answers;  // per batch, until collected
+    std::function<void()> onRead;  // called at each depth read, if set
 
     void finishDrawing() override { ++finishes; }
 
@@ -1001,6 +1002,7 @@ struct DepthBackend final : QueryBackend {
     void release(QueryId) override {}
     bool readDepth(std::vector<float>& d, int& w, int& h) override {
         ++reads;
+        if (onRead) onRead();
         w = 640;
         h = 320;
         d.assign(std::size_t{640} * 320, depth);
@@ -1144,46 +1146,61 @@ TEST(TwoPhaseStats, SplitDrawWaitsWaitsBeforeEveryReadAndTestAndDecidesAlike) {
     EXPECT_EQ(drawn[0], drawn[1]);
 }
 
-// Where the tests cull nothing (Sponza's case), the cost model stops reading depth back
-// after the first frame and tries again every probeFrames frames; once occlusion appears,
+// Where the tests cull nothing (Sponza's case), the cost model stops testing after the
+// first frame and probes again every probeFrames frames: by default at the frame's end,
+// testing the parts drawn against a pyramid of the final depth (one read after every
+// draw, no raster test); in the ablation with a frame that tests. Once occlusion appears,
 // the next probe finds it and testing resumes. Every frame draws at least what vfc draws
 // while nothing is occluded.
 TEST(TwoPhaseCosts, TestsStopWhereTheyCullNothingAndResumeWhenTheyWould) {
     TestScene s(4, 3);
     const auto reference = vfcDrawn(s);
-    DepthBackend backend;
+    TwoLevelTree tree(s.bsp, s.objects);
     SchedulerParams p = twoPhase();
     p.tuning.costs.probeFrames = 8;
     p.tuning.costs.depthReadNs = 1000.0;  // less than drawing this small scene's 144 triangles
-    QueryScheduler sched(p);
-    TwoLevelTree tree(s.bsp, s.objects);
-    std::vector<std::uint32_t> testedFrames;
-    for (std::uint32_t f = 1; f <= 20; ++f) {
-        RecordingSink sink;
-        const int before = backend.reads;
-        const FrameStats st = sched.cullFrame(tree, frontCamera(), 640, 320, backend, sink);
-        EXPECT_EQ(st.pyramidBuilds, static_cast<std::uint32_t>(backend.reads - before)) << "a pyramid from every depth read";
-        if (backend.reads > before) testedFrames.push_back(f);
-        EXPECT_EQ(sink.drawn, reference) << "frame " << f;
-    }
-    EXPECT_EQ(testedFrames, (std::vector<std::uint32_t>{1, 9, 17}));
-
-    // Everything is hidden from now on: the probe at frame 25 finds it, and from the frame
-    // after it nothing is drawn.
-    backend.depth = 1.0f;
-    backend.rule = [](const QueryVolume&) { return QueryResult::Occluded; };
-    std::size_t drawnAt26 = 99, drawnAt27 = 99;
-    for (std::uint32_t f = 21; f <= 27; ++f) {
-        RecordingSink sink;
-        sched.cullFrame(tree, frontCamera(), 640, 320, backend, sink);
-        if (f < 25) {
-            EXPECT_EQ(sink.drawn, reference) << "frame " << f;  // tests still off
+    for (const bool endProbes : {true, false}) {
+        SCOPED_TRACE(endProbes ? "probes at the frame's end" : "probes by frames that test");
+        p.features.useEndProbes = endProbes;
+        DepthBackend backend;
+        QueryScheduler sched(p);
+        std::vector<std::uint32_t> readFrames;
+        for (std::uint32_t f = 1; f <= 20; ++f) {
+            RecordingSink sink;
+            std::size_t drawnAtRead = 0;
+            backend.onRead = [&] { drawnAtRead = sink.drawn.size(); };
+            const int reads = backend.reads, batches = backend.batches;
+            const FrameStats st = sched.cullFrame(tree, frontCamera(), 640, 320, backend, sink);
+            EXPECT_EQ(st.pyramidBuilds, static_cast<std::uint32_t>(backend.reads - reads)) << "a pyramid from every depth read";
+            if (backend.reads > reads) readFrames.push_back(f);
+            if (endProbes && f > 1 && backend.reads > reads) {
+                EXPECT_EQ(backend.reads - reads, 1) << "frame " << f;
+                EXPECT_EQ(drawnAtRead, sink.drawn.size()) << "frame " << f << ": read after every draw";
+                EXPECT_EQ(backend.batches, batches) << "frame " << f << ": no raster test";
+            }
+            EXPECT_EQ(sink.drawn, reference) << "frame " << f;
         }
-        if (f == 26) drawnAt26 = sink.drawn.size();
-        if (f == 27) drawnAt27 = sink.drawn.size();
+        EXPECT_EQ(readFrames, (std::vector<std::uint32_t>{1, 9, 17}));
+        backend.onRead = nullptr;
+
+        // Everything is hidden from now on: the probe at frame 25 finds it, and from the
+        // frame after it nothing is drawn.
+        backend.depth = 1.0f;
+        backend.rule = [](const QueryVolume&) { return QueryResult::Occluded; };
+        std::size_t drawnAt26 = 99, drawnAt27 = 99;
+        for (std::uint32_t f = 21; f <= 27; ++f) {
+            RecordingSink sink;
+            sched.cullFrame(tree, frontCamera(), 640, 320, backend, sink);
+            // Tests still off; a probe at the frame's end draws first.
+            if (f < 25 || (endProbes && f == 25)) {
+                EXPECT_EQ(sink.drawn, reference) << "frame " << f;
+            }
+            if (f == 26) drawnAt26 = sink.drawn.size();
+            if (f == 27) drawnAt27 = sink.drawn.size();
+        }
+        EXPECT_EQ(drawnAt26, 0u);
+        EXPECT_EQ(drawnAt27, 0u);
     }
-    EXPECT_EQ(drawnAt26, 0u);
-    EXPECT_EQ(drawnAt27, 0u);
 
     // The ablation tests every frame.
     p.features.useCostModel = false;
