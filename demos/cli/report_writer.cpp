@@ -169,6 +169,23 @@ std::vector<ModeSummary> summarise(const BenchResult& r) {
         const std::size_t h = ratios.size() / 2;
         out[m].pairedVsBest = ratios.size() % 2 ? ratios[h] : 0.5 * (ratios[h - 1] + ratios[h]);
     }
+    if (vfc >= 0 && r.frames.size() > 1) {
+        for (std::size_t m = 0; m < r.modes.size(); ++m) {
+            std::vector<std::pair<double, std::size_t>> byFrame;
+            for (std::size_t k = 1; k < r.frames.size(); ++k) {
+                const double base = r.frames[k][static_cast<std::size_t>(vfc)].stats.frameMs;
+                if (base > 0) byFrame.push_back({r.frames[k][m].stats.frameMs / base, k});
+            }
+            if (byFrame.empty()) continue;
+            std::sort(byFrame.begin(), byFrame.end());
+            const std::size_t n = byFrame.size(), h = n / 2;
+            ModeSummary& s = out[m];
+            s.vfcRatioMedian = n % 2 ? byFrame[h].first : 0.5 * (byFrame[h - 1].first + byFrame[h].first);
+            s.vfcRatioP95 = byFrame[(95 * n + 99) / 100 - 1].first;  // nearest rank: ceil(0.95 n)
+            s.vfcRatioMax = byFrame.back().first;
+            s.vfcRatioMaxFrame = byFrame.back().second;
+        }
+    }
     int oracle = -1;
     for (std::size_t i = 0; i < out.size(); ++i)
         if (out[i].oracle && (oracle < 0 || out[i].name == "oracle")) oracle = static_cast<int>(i);  // "vs oracle": the parts' oracle
@@ -266,7 +283,8 @@ Status writeSummaryCsv(const std::vector<ModeSummary>& summary, const fs::path& 
          "leaf_surface_area,leaf_triangles_mean,leaf_triangles_max,paired_vs_best,false_positives_queried,"
          "false_positives_history,false_positives_occupancy,false_positives_other,draw_queries,draw_queries_occluded,"
          "depth_tests,ms_depth_read,raster_tests,ms_raster,claimed_error_pct_mean,claimed_error_pct_max,"
-         "pixels_lost_pct_max,frames_over_claim_truth,frames_over_claim_image,frames_unbounded,pixels_tied,pop_in_per_frame,pyramid_builds\n";
+         "pixels_lost_pct_max,frames_over_claim_truth,frames_over_claim_image,frames_unbounded,pixels_tied,pop_in_per_frame,pyramid_builds,"
+         "frame_ratio_vfc_median,frame_ratio_vfc_p95,frame_ratio_vfc_max\n";
     for (const ModeSummary& s : summary)
         f << s.name << ',' << s.frames << ',' << s.msMean << ',' << s.msMedian << ',' << s.msMin << ',' << s.msMax
           << ',' << s.traversalMs << ',' << s.queryMs << ',' << s.waitMs << ',' << s.drawMs << ',' << s.ratioVfc << ',' << s.ratioOracle
@@ -280,7 +298,8 @@ Status writeSummaryCsv(const std::vector<ModeSummary>& summary, const fs::path& 
           << s.fpOccupancy << ',' << s.fpOther << ',' << s.drawQueries << ',' << s.drawQueriesOccluded << ','
           << s.depthTests << ',' << s.depthReadMs << ',' << s.rasterTests << ',' << s.rasterMs << ',' << s.claimedPctMean
           << ',' << s.claimedPctMax << ',' << s.lostPctMax << ',' << s.framesOverClaimTruth << ',' << s.framesOverClaimImage
-          << ',' << s.framesUnbounded << ',' << s.tiedPixels << ',' << s.popIn << ',' << s.pyramidBuilds << '\n';
+          << ',' << s.framesUnbounded << ',' << s.tiedPixels << ',' << s.popIn << ',' << s.pyramidBuilds << ','
+          << s.vfcRatioMedian << ',' << s.vfcRatioP95 << ',' << s.vfcRatioMax << '\n';
     return closeChecked(f, path);
 }
 
@@ -541,8 +560,6 @@ void writeFalsePositiveTable(std::ostream& f, const BenchResult& r, const std::v
       << fmt(budgetTris / n, 0) << " triangles a frame.\n";
 }
 
-}  // namespace
-
 void writeClaimTable(std::ostream& f, const std::vector<ModeSummary>& summary) {
     // Only modes that cull approximately: they claim something, or act without a bound.
     bool any = false;
@@ -564,6 +581,21 @@ void writeClaimTable(std::ostream& f, const std::vector<ModeSummary>& summary) {
          "nothing was lost (depth ties drawn in another order); frames *without a bound* culled on last frame's "
          "answers and claim nothing. Pop-in: parts missing in one frame and drawn in the next.\n";
 }
+
+void writeFrameRatioTable(std::ostream& f, const std::vector<ModeSummary>& summary) {
+    if (std::none_of(summary.begin(), summary.end(), [](const ModeSummary& s) { return s.vfcRatioMedian > 0; })) return;
+    f << "\n## Each frame against vfc\n\n"
+      << "| mode | median | 95th percentile | worst (frame) |\n|---|--:|--:|--:|\n";
+    for (const ModeSummary& s : summary)
+        if (s.vfcRatioMedian > 0 && s.name != "vfc")
+            f << "| " << s.name << " | " << fmt(s.vfcRatioMedian, 3) << " | " << fmt(s.vfcRatioP95, 3) << " | "
+              << fmt(s.vfcRatioMax, 3) << " (" << s.vfcRatioMaxFrame << ") |\n";
+    f << "\nA mode's ms over vfc's in the same frame, over frames 1 and up (frame 0 builds every mode's history); "
+         "the 95th percentile is the nearest rank. `vfc-again`, where run, is vfc against itself: the noise floor "
+         "of these ratios.\n";
+}
+
+}  // namespace
 
 Status writeReport(const BenchResult& r, const std::vector<ModeSummary>& summary, const std::string& command,
                    const std::vector<std::string>& plots, const std::string& streaming, const fs::path& path) {
@@ -613,6 +645,7 @@ Status writeReport(const BenchResult& r, const std::vector<ModeSummary>& summary
          "(ground truth) not drawn, summed over frames, with the pixels they own; false positives are drawn parts "
          "with no visible pixel; the largest wrong region is the biggest 4-connected blob of wrong pixels in any "
          "frame. `*` marks modes on the speed-accuracy Pareto front (the oracle is a bound, not a mode).\n";
+    writeFrameRatioTable(f, summary);
     writeFalsePositiveTable(f, r, summary);
     writeCheapTestTable(f, summary);
     writeClaimTable(f, summary);

@@ -48,6 +48,11 @@ struct ModeSummary {
     /// frame (modes run interleaved, so the pairing cancels load drift on a shared machine);
     /// 0 unless the mode queries node volumes.
     double pairedVsBest = 0;
+    /// Over frames 1 and up (frame 0 builds every mode's history), this mode's ms over vfc's
+    /// in the same frame: the median, the 95th percentile (nearest rank) and the worst, and
+    /// that frame's number; 0 without vfc or a second frame.
+    double vfcRatioMedian = 0, vfcRatioP95 = 0, vfcRatioMax = 0;
+    std::size_t vfcRatioMaxFrame = 0;
     LeafVolumeTotals leaves;       ///< world-space leaf volumes at the last frame (leaves == 0: n/a)
     bool pareto = false;  ///< on the speed-accuracy Pareto front (the oracle never is: it is not a real mode)
     std::string family;   ///< ModeSpec::family: the curve it belongs to in the speed-accuracy plot

@@ -176,5 +176,30 @@ TEST(BenchModes, EachFamilysCurveIsItsOwnFront) {
     EXPECT_TRUE(at("full").pareto);
 }
 
+// Each frame's ratio to vfc, over frames 1 and up: the median, the 95th percentile by
+// nearest rank and the worst frame, which the "95th percentile" target reads.
+TEST(BenchReport, EachFrameAgainstVfcSkipsTheFirstFrame) {
+    BenchResult r;
+    r.width = 100;
+    r.height = 10;
+    for (const char* name : {"vfc", "full"}) r.modes.push_back(modeFromName(name).take());
+    // Frame 0 at 100x, then frames 1..20 at ratios 0.5, 0.55, ..., 1.45 in shuffled order.
+    for (std::size_t k = 0; k <= 20; ++k) {
+        std::vector<ModeFrame> row(2);
+        row[0].stats.frameMs = 10.0;
+        const std::size_t rank = k == 0 ? 0 : (k * 7) % 20;  // 7 is coprime with 20: a permutation
+        row[1].stats.frameMs = k == 0 ? 1000.0 : 10.0 * (0.5 + 0.05 * double(rank));
+        r.frames.push_back(row);
+    }
+    r.truth.resize(r.frames.size());
+    const std::vector<ModeSummary> s = summarise(r);
+    const ModeSummary& full = s[std::size_t(findMode(s, "full"))];
+    EXPECT_NEAR(full.vfcRatioMedian, 0.5 * (0.95 + 1.0), 1e-9);
+    EXPECT_NEAR(full.vfcRatioP95, 1.40, 1e-9) << "the 19th of 20";
+    EXPECT_NEAR(full.vfcRatioMax, 1.45, 1e-9);
+    EXPECT_EQ(full.vfcRatioMaxFrame, 17u) << "17 * 7 = 119: rank 19";
+    EXPECT_NEAR(s[std::size_t(findMode(s, "vfc"))].vfcRatioP95, 1.0, 1e-12);
+}
+
 }  // namespace
 }  // namespace dyncull::cli
