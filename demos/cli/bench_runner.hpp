@@ -1,8 +1,9 @@
 // Runs several culling configurations ("modes") interleaved over the same frames of one
 // scene and measures each against the truth: the scene is moved once per frame, the exact
 // visible set is computed by an ID pass (untimed), then every mode renders that frame with
-// its own QueryScheduler (own visibility history), vfc first so its image is the
-// reference. Shared by `dyncull bench` and `dyncull sweep` (and the conservative test).
+// its own QueryScheduler (own visibility history), in an order rotated every frame; vfc's
+// image is the reference. Shared by `dyncull bench` and `dyncull sweep` (and the
+// conservative test).
 #pragma once
 
 #include <cstdint>
@@ -115,8 +116,8 @@ struct ModeFrame {
     FalsePositiveCauses falsePositiveCauses;  ///< parts.falsePositives by cause (scheduler modes)
 };
 
-/// Parts whose query volume passes a query against the frame's final depth (all of vfc's
-/// drawing): what a conservative query-based mode with that volume must draw at least if
+/// Parts whose query volume passes a query against the frame's final depth (drawn, untimed,
+/// before the modes from the parts that own a pixel): what a conservative query-based mode with that volume must draw at least if
 /// it had perfect order and no history. Measured only with --volume-bound.
 struct VolumeBound {
     std::uint32_t parts = 0;
@@ -198,6 +199,10 @@ public:
     /// ground truth's cluster ids (which clusters own pixels).
     /// Always on when a mode is oracle-boxes.
     void setMeasureVolumeBound(bool on, double budgetPercent = kDefaultBoundBudgetPercent);
+    /// Shifts the rotation of the modes' order by `offset` places: each pass of a
+    /// measurement shifts it by its number, so that a mode that came first in a frame in one
+    /// pass does not in the next, and each mode's least time over the passes avoids that place.
+    void setOrderOffset(std::size_t offset) { orderOffset_ = offset; }
     /// Fills result().leafTotals from the scene as it is now (call after the last frame).
     void measureLeafVolumes();
     /// Takes another pass over the same frames and modes (`other`, from a fresh runner):
@@ -235,6 +240,8 @@ private:
     std::vector<NodeTrace> trace_;
     bool measureBound_ = false;
     std::vector<std::vector<NodeRef>> missing_;  // per mode: last frame's visible parts not drawn
+    std::vector<std::vector<NodeRef>> drawn_;    // per mode: this frame's leaves drawn (runFrame's scratch)
+    std::size_t orderOffset_ = 0;               // setOrderOffset
     std::vector<std::uint8_t> diffMask_;         // reused per mode and frame
 
     /// Queries the volume of every part in the frustum against the depth buffer as it is.

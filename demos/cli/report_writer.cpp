@@ -618,7 +618,7 @@ Status writeReport(const BenchResult& r, const std::vector<ModeSummary>& summary
       << "- loose-BSP relink: " << fmt(updateMs / n, 2) << " ms per frame, done once per frame before the modes "
       << "(not counted in any mode)\n"
       << "- modes run interleaved: per frame the scene moves once, then every mode renders that frame with its own "
-         "scheduler and history, vfc first (its image is the reference), the others in an order rotated every frame\n";
+         "scheduler and history, in an order rotated every frame (vfc's image, the reference, is compared after all are drawn)\n";
     if (r.passes > 1)
         f << "- times: each mode's least over " << r.passes << " passes of the frames, each from a fresh scene, engine and "
           << "schedulers (everything else from the first pass); " << r.passFramesApart

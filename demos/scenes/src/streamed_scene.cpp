@@ -67,6 +67,7 @@ public:
     Status update(Engine&, std::uint64_t) override { return {}; }
     void beginFrame(const Camera& camera) override { objects_->beginFrame(camera); }
     void setReferencePass(bool on) override { objects_->setLate(on ? StreamLate::Wait : late_); }
+    bool referencePassLoads() const override { return true; }
     Expected<std::optional<StreamingFrameStats>> endFrame() override {
         auto s = objects_->endFrame();
         // The dyncull program keeps freed heap memory for llvmpipe's sake; the leaves this

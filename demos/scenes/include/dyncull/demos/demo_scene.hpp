@@ -44,6 +44,9 @@ public:
     /// On while `bench` renders its reference image (vfc): a scene that may leave work
     /// out (streamed leaves not yet read, StreamLate::Draw or Skip) does it all then.
     virtual void setReferencePass(bool /*on*/) {}
+    /// True for a scene whose reference pass changes what the passes after it find (it
+    /// waits for streamed leaves, which stay read): `bench` then renders vfc first.
+    virtual bool referencePassLoads() const { return false; }
     /// For ground truth: the world-space geometry an object (by slot) really has when its
     /// Engine model is only a box standing for it (streamed leaves); empty for scenes whose
     /// models are their geometry. The function fills the mesh and returns true for such
