@@ -147,9 +147,9 @@ void QueryScheduler::recordClusterVisibility(Frame& f) {
     // own verdicts; the bits are set after the join, since two parts of one object may
     // share a word of them.
     std::size_t split = clusterParts_.size();
+    std::size_t total = 0;
+    for (const NodeRef ref : clusterParts_) total += partClusters(objs, ref).size();
     if (params_.features.useClusterWorker) {
-        std::size_t total = 0;
-        for (const NodeRef ref : clusterParts_) total += partClusters(objs, ref).size();
         if (total >= params_.tuning.recordWorkerClusters) {
             std::size_t half = 0;
             split = 0;
@@ -183,10 +183,12 @@ void QueryScheduler::recordClusterVisibility(Frame& f) {
     }
     assert(next == recordShown_.size());
     f.stats.clusterMs += msSince(t1);
-    // Its price for the cost model: the tests, and a read that waits for nothing plus the
-    // build. The wait for the frame's drawing is the drawing's, due by the frame's end
-    // anyway; counted here it made the price swing with the frame and the record turn off.
-    clusterRecordNs_ = 1e6 * msSince(t1) + params_.tuning.costs.pyramidNs;
+    // Its price for the cost model, from counts as every other price: a read that waits
+    // for nothing plus the build, and the tests, halved where the worker shares them.
+    // Timed, it swung with the frame (a wait for the drawing, a thread descheduled on two
+    // cores), and one slow frame turned the record off until the next probe.
+    const double threads = split < clusterParts_.size() ? 2.0 : 1.0;
+    clusterRecordNs_ = params_.tuning.costs.pyramidNs + double(total) * params_.tuning.costs.recordNsPerCluster / threads;
     lastClusterRecordFrame_ = f.index;
 }
 
@@ -221,7 +223,7 @@ void QueryScheduler::readClusterMarks(Frame& f) {
         }
         setClusterBit(bits, m.cluster, true);
     }
-    clusterRecordNs_ = 1e6 * msSince(t0);
+    clusterRecordNs_ = params_.tuning.costs.pyramidNs;  // a read of the marks, priced as a depth read that waits for nothing
     f.stats.clusterMs += msSince(t0);
     lastClusterRecordFrame_ = f.index;
 }

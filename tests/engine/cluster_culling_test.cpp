@@ -207,6 +207,51 @@ TEST_F(ClusterHistory, TheWorkerDecidesAsTheRenderThreadDoes) {
     EXPECT_EQ(ctx_->checkErrors(), 0u);
 }
 
+TEST_F(ClusterHistory, TheRecordIsPricedFromCountsSoTwinsDecideAlike) {
+    // With the cost model on, cluster history's frame-end record runs while what its bits
+    // saved exceeds its price, and otherwise every probeFrames frames. The price comes from
+    // counts (TestCosts), not from the record's time, so two schedulers with the same
+    // parameters decide alike in every frame however the threads were scheduled; a record
+    // priced above any saving runs only on probe frames, and the frames after them are the
+    // only ones that defer clusters; priced at nothing, it runs wherever it saved something.
+    build({2000, 8, 3.2f, 1.0f, {2.2f, 1.6f, 2.2f}});
+    if (HasFatalFailure()) return;
+    SchedulerParams cheap = paramsOf(CullMode::TwoPhase, true);
+    cheap.features.useCostModel = true;
+    cheap.tuning.costs.depthReadNs = 0.0;  // the frame's tests always pay: only the record's model is in play
+    cheap.tuning.costs.probeFrames = 8;
+    SchedulerParams dear = cheap;
+    cheap.tuning.costs.pyramidNs = 0.0;
+    cheap.tuning.costs.recordNsPerCluster = 0.0;
+    dear.tuning.costs.recordNsPerCluster = 1e12;  // more than any drawing it could save
+    QueryScheduler a(dear), twin(dear), c(cheap);
+    constexpr int kFrames = 24;
+    int deferringDear = 0, deferringCheap = 0;
+    for (int f = 0; f < kFrames; ++f) {
+        SCOPED_TRACE("frame " + std::to_string(f));
+        circle(0.12f * float(f), 8.0f, 1.0f);
+        Image images[3];
+        const FrameStats x = render(a, images[0]);
+        const FrameStats y = render(twin, images[1]);
+        const FrameStats z = render(c, images[2]);
+        EXPECT_EQ(x.trianglesDrawn, y.trianglesDrawn);
+        EXPECT_EQ(x.pyramidBuilds, y.pyramidBuilds);
+        EXPECT_EQ(x.clustersDeferred, y.clustersDeferred);
+        EXPECT_EQ(x.earlyTriangles, y.earlyTriangles);
+        EXPECT_EQ(differingPixels(images[0], images[2]), 0u);
+        deferringDear += x.clustersDeferred > 0;
+        deferringCheap += z.clustersDeferred > 0;
+    }
+    std::printf("frames deferring clusters: %d with the record priced above any saving, %d priced at nothing (of %d)\n",
+                deferringDear, deferringCheap, kFrames);
+    EXPECT_GE(deferringDear, 1);  // the probes still record
+    // Until a frame with bits has measured what they save, the record runs (frames 0 and
+    // 1); then once every probeFrames frames.
+    EXPECT_LE(deferringDear, 1 + kFrames / 8);
+    EXPECT_GT(deferringCheap, kFrames / 2);
+    EXPECT_EQ(ctx_->checkErrors(), 0u);
+}
+
 TEST_F(ClusterCulling, PixelSizedClustersKeepTheImageExact) {
     // Spheres of one to a few pixels, so that most clusters cover a pixel centre or two, or
     // none: the depth-pyramid tests read only the pixels whose centres a box can cover

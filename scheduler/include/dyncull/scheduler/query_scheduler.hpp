@@ -202,7 +202,9 @@ inline std::uint64_t errorBudgetPixels(double percent, int width, int height) {
 /// depth drawn so far culls beyond the early one (27% on the power plant, 39% on the city,
 /// 60% on the bunny path), are worth more drawing than `pyramidNs`, a depth read that
 /// waits for nothing and the build (`bench_volume_tests`, `bench_depth_pyramid`). Cluster
-/// history's record at the frame's end is priced the same: `pyramidNs` plus its tests' CPU.
+/// history's record at the frame's end is priced the same: `pyramidNs` plus
+/// `recordNsPerCluster` per cluster it tests (`BM_ClusterRecord`), over the threads that
+/// share them (counts, not its time: a timed price swung with the frame).
 struct TestCosts {
     double drawNsPerTriangle = 53.0;
     double testNsPerVolume = 2700.0;
@@ -210,6 +212,7 @@ struct TestCosts {
     double triangleTestNsPerPart = 0.0;
     double triangleTestNsPerTriangle = 69.0;
     double clusterTestNs = 90.0;
+    double recordNsPerCluster = 118.0;
     double drawNsPerRange = 0.0;
     double depthReadNs = 400000.0;
     double pyramidNs = 180000.0;
@@ -610,8 +613,8 @@ private:
     std::vector<NodeRef> clusterParts_;
     std::uint32_t lastDeferred_ = 0;  // clusters the last cullClusters call deferred
     /// Cluster history's cost model: this frame's deferred triangles that the late pass did
-    /// not draw, the drawing they saved the last frame that used bits (ns), what the last
-    /// recording cost (ns, CPU and readback), and that recording's frame.
+    /// not draw, the drawing they saved the last frame that used bits (ns), the last
+    /// recording's price (ns, TestCosts: readback and tests), and that recording's frame.
     std::uint64_t deferredTriangles_ = 0;
     double clusterBitsSavedNs_ = 1e300, clusterRecordNs_ = 0.0;
     std::uint32_t lastClusterRecordFrame_ = ~0u - 1;  // none yet: one past it is no frame's "last frame" either
