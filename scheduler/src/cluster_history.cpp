@@ -16,14 +16,6 @@
 
 namespace dyncull {
 
-namespace {
-/// The record tests a cluster at the finest pyramid level its rectangle spans at most
-/// this many texels of (up to 256 reads). Not the late pass's clusterPyramidSpan: at 32
-/// and 64 the record took long enough that its cost model turned it off more often, and
-/// the city drew more early triangles (docs/BENCHMARKS.md, "cluster span").
-constexpr int kRecordSpan = 16;
-}  // namespace
-
 void QueryScheduler::startDeferredSelection(Frame& f) {
     if (!params_.features.useClusterWorker || deferredParts_.empty()) return;
     if (!deferredSelection_) deferredSelection_ = std::make_unique<DeferredSelection>();
@@ -130,7 +122,7 @@ void QueryScheduler::recordVerdicts(const Frame& f, std::span<const NodeRef> par
             float nearest = 1.0f;
             const bool hidden = (cones && eye.backFacing(c)) ||
                                 (f.screen.roughBoxDepth(toClip, c.box, centres, nearest) &&
-                                 (centres.empty() || pyramid_.occluded(centres, nearest, kRecordSpan)));
+                                 (centres.empty() || pyramid_.occluded(centres, nearest, params_.tuning.recordPyramidSpan)));
             shown.push_back(hidden ? 0 : 1);
         }
     }

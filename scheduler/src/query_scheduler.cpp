@@ -70,6 +70,8 @@ Status validateSchedulerParams(const SchedulerParams& p) {
     if (p.tuning.candidateRounds < 1 || p.tuning.candidateRounds > 16) return Error{"candidateRounds must be in [1, 16]"};
     if (p.tuning.clusterPyramidSpan < 2 || p.tuning.clusterPyramidSpan > 64)
         return Error{"clusterPyramidSpan must be in [2, 64] (texels)"};
+    if (p.tuning.recordPyramidSpan < 2 || p.tuning.recordPyramidSpan > 64)
+        return Error{"recordPyramidSpan must be in [2, 64] (texels)"};
     return {};
 }
 

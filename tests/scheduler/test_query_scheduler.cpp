@@ -394,6 +394,9 @@ TEST(QueryScheduler, ParamsAreValidated) {
         p = {};
         p.tuning.clusterPyramidSpan = span;
         EXPECT_FALSE(validateSchedulerParams(p).ok()) << span;
+        p = {};
+        p.tuning.recordPyramidSpan = span;
+        EXPECT_FALSE(validateSchedulerParams(p).ok()) << span;
     }
     for (const std::uint32_t rounds : {0u, 17u}) {
         p = {};
@@ -404,6 +407,7 @@ TEST(QueryScheduler, ParamsAreValidated) {
     p.tuning.candidateRounds = 16;
     p.tuning.pyramidSpan = 64;
     p.tuning.clusterPyramidSpan = 2;
+    p.tuning.recordPyramidSpan = 64;
     EXPECT_TRUE(validateSchedulerParams(p).ok());
     EXPECT_FALSE(parseCullMode("fast").ok());
     EXPECT_EQ(parseCullMode("full").value(), CullMode::TwoPhase);

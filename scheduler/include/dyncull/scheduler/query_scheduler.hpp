@@ -266,6 +266,12 @@ struct SchedulerTuning {
     /// to the box's projection: 32 drew 7% fewer triangles than 4 on the power plant for 5%
     /// more cluster-test time (docs/BENCHMARKS.md, "cluster span").
     int clusterPyramidSpan = 32;
+    /// The same for cluster history's record at the frame's end (cluster_history.cpp), in
+    /// [2, 64]: it only chooses next frame's early clusters, so a coarser test costs drawing,
+    /// never a wrong pixel. 64 drew 4% fewer triangles than 16 on the city and 2% more time
+    /// on the power plant's record; the bunny path's clusters are small enough that both
+    /// decide alike (docs/BENCHMARKS.md, "record span").
+    int recordPyramidSpan = 16;
     /// TwoPhase: the late pass's candidates are tested in this many rounds, front to back
     /// (at least 1, at most 16): each round is tested against the depth of the rounds before
     /// it, whose visible parts are drawn first, at the price of one more wait per round. 2
