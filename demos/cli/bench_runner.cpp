@@ -79,7 +79,7 @@ bool applyTwoPhaseName(const std::string& part, ModeSpec& m) {
     if (part != "full" && part != "full-hzb" && part != "full-nohist" && part != "full-nocost" && part != "full-tri" &&
         part != "full-noclusters" && part != "full-noclusterhist" && part != "full-markclusterhist" && part != "full-noworker" &&
         part != "full-ring" && part != "full-splitwaits" && part != "full-noroundpyramid" &&
-        part != "full-nosubmit" && part != "full-testprobe")
+        part != "full-nosubmit" && part != "full-testprobe" && part != "full-rasterrefresh")
         return false;
     m.scheduler.mode = CullMode::TwoPhase;
     m.scheduler.features.useBatchedRaster = part != "full-hzb";
@@ -101,6 +101,7 @@ bool applyTwoPhaseName(const std::string& part, ModeSpec& m) {
     m.scheduler.features.useRoundPyramids = part != "full-noroundpyramid";
     if (part == "full-nosubmit") m.submitTriangles = 0;
     m.scheduler.features.useEndProbes = part != "full-testprobe";
+    m.scheduler.features.useRefreshPyramid = part != "full-rasterrefresh";
     return true;
 }
 
@@ -111,7 +112,7 @@ std::string modeNamesHelp() {
            "queries (hardware occlusion queries with history, batching and occupancy maps; the default before two-phase), oracle (the visible parts, whole), oracle-clusters (only their clusters that own a pixel), "
            "oracle-boxes (every cluster whose box passes against the final depth: the floor of a cluster-box culler; measures --volume-bound), "
            "oracle-budgetP (oracle-clusters less what an oracle with a budget of P% of the pixels leaves out); "
-           "ablations of full: full-hzb (the pyramid alone), full-tri (every part whose volume passes then tested on its own triangles, and draws marked), full-nohist (every part drawn early tested again each frame), full-nocost (every volume the pyramid lets through tested), full-noclusters (parts drawn whole, no cluster tests), full-noclusterhist (early parts drawn with all their clusters, not only those that showed last frame), full-markclusterhist (which clusters showed judged by their fragments' marks when drawn, not by their boxes against the final depth), full-noworker (the deferred clusters tested on the render thread as they are drawn, not ahead of them on a worker), full-ring (every volume's outline widened by a ring, boxes not grown across the view), full-noroundpyramid (the clusters of parts drawn after a raster test tested against the early pass's pyramid, not one built again before their round), full-splitwaits (full, measuring: waits for the drawing apart before each depth read and raster test, and times the pyramid tests: the Cheap tests table's own cost per test), full-nosubmit (full with its drawing handed to the GPU only where it reads something back, not every EngineOptions::submitTriangles triangles), full-testprobe (the cost model's probe, while tests are off, a frame that tests rather than a test of the frame's parts against its final depth); "
+           "ablations of full: full-hzb (the pyramid alone), full-tri (every part whose volume passes then tested on its own triangles, and draws marked), full-nohist (every part drawn early tested again each frame), full-nocost (every volume the pyramid lets through tested), full-noclusters (parts drawn whole, no cluster tests), full-noclusterhist (early parts drawn with all their clusters, not only those that showed last frame), full-markclusterhist (which clusters showed judged by their fragments' marks when drawn, not by their boxes against the final depth), full-noworker (the deferred clusters tested on the render thread as they are drawn, not ahead of them on a worker), full-ring (every volume's outline widened by a ring, boxes not grown across the view), full-noroundpyramid (the clusters of parts drawn after a raster test tested against the early pass's pyramid, not one built again before their round), full-splitwaits (full, measuring: waits for the drawing apart before each depth read and raster test, and times the pyramid tests: the Cheap tests table's own cost per test), full-nosubmit (full with its drawing handed to the GPU only where it reads something back, not every EngineOptions::submitTriangles triangles), full-testprobe (the cost model's probe, while tests are off, a frame that tests rather than a test of the frame's parts against its final depth), full-rasterrefresh (the parts drawn early tested for next frame by a batched raster test against the final depth, not against the pyramid of the final depth that cluster history's record reads); "
            "vfc-noclusters (vfc drawing parts whole), vfc-again (vfc a second time, among the other modes: the noise floor of a ratio to vfc); "
            "approximate full: budgetP (at most P percent of the frame's pixels lost, e.g. budget0.1), budgetearlyP (and early-set parts showing less than the budget handed to it), budgetrecountP (the parts that could fit drawn last, counted again against the depth of the rest); "
            "settings of queries: approximate thrN (pixel threshold), latency1 (last frame's results), "

@@ -44,6 +44,8 @@ struct QueryScheduler::Frame {
     /// TwoPhase, the cost model's probe in a frame that does not test: every part drawn
     /// (but those certainly visible) is tested against the final depth at the frame's end.
     bool probeAtEnd = false;
+    /// The depth pyramid holds this frame's final depth (testOnFinalPyramid read it).
+    bool finalPyramid = false;
 
     const Camera& camera() const { return view.camera; }
     const Frustum& frustum() const { return view.frustum; }

@@ -45,7 +45,7 @@ void QueryScheduler::runTwoPhase(Frame& f) {
 
     // The cost model may turn this frame's tests off. Every probeFrames frames it probes
     // whether they would pay again: at the frame's end, testing every part drawn against
-    // a pyramid of the final depth (probeFinalDepth: a depth read that waits for nothing
+    // a pyramid of the final depth (testOnFinalPyramid: a depth read that waits for nothing
     // the frame's end does not wait for, and no early pass's stall); or, where the sink
     // tests triangles, with a frame that tests.
     const bool pays = !params_.features.useCostModel || savedNs_ > params_.tuning.costs.depthReadNs;
@@ -113,9 +113,12 @@ void QueryScheduler::runTwoPhase(Frame& f) {
     if (!candidates_.empty()) testCandidates(f, triangles);
     if (!triangleTests_.empty()) testTriangles(f);
     if (triangles) readDrawMarks(f);
+    // The budget's early-set rule needs each part's samples, which only the raster test counts.
+    const bool refreshOnPyramid = params_.features.useRefreshPyramid && f.recordClusterBits && !f.markClusters &&
+                                  !(params_.approx.errorBudgetPercent > 0.0 && params_.approx.budgetEarlySet);
     if (f.probeAtEnd) {
-        probeFinalDepth(f);
-    } else if (!refresh_.empty()) {
+        testOnFinalPyramid(f);
+    } else if (!refresh_.empty() && !(refreshOnPyramid && testOnFinalPyramid(f))) {
         testRefresh(f);
     }
     if (f.markClusters) {
@@ -262,9 +265,11 @@ void QueryScheduler::lateTraversal(Frame& f, bool testing, bool haveDepth, bool 
 
 namespace {
 /// The cost model's rate of "occluded" answers moves a quarter of the way to a batch's.
+void learnOccludedRate(double& rate, std::size_t occluded, std::size_t answers) {
+    rate += 0.25 * (double(occluded) / double(answers) - rate);
+}
 void learnOccludedRate(double& rate, const std::vector<QueryResult>& answers) {
-    const auto occluded = std::count(answers.begin(), answers.end(), QueryResult::Occluded);
-    rate += 0.25 * (double(occluded) / double(answers.size()) - rate);
+    learnOccludedRate(rate, static_cast<std::size_t>(std::count(answers.begin(), answers.end(), QueryResult::Occluded)), answers.size());
 }
 }  // namespace
 
@@ -376,20 +381,28 @@ void QueryScheduler::testRefresh(Frame& f) {
     }
 }
 
-void QueryScheduler::probeFinalDepth(Frame& f) {
+bool QueryScheduler::testOnFinalPyramid(Frame& f) {
     // A part drawn whose volume is behind the final depth would have been culled by a
-    // frame that tests (or left its early set): what testing would save, as the late
-    // pass's first test measures it. Its own fragments are in that depth, never behind
-    // its volume's nearest point, so a part that shows is never called hidden.
-    if (refresh_.empty() || !buildPyramid(f)) return;
+    // frame that tests, or leaves the early set: what testing saves, as the late pass's
+    // first test measures it. Its own fragments are in that depth, never behind its
+    // volume's nearest point, so a part that shows is never called hidden.
+    if (refresh_.empty()) return true;
+    if (!f.finalPyramid && !buildPyramid(f)) return false;
+    f.finalPyramid = true;
+    std::size_t hiddenParts = 0;
     for (const NodeRef ref : refresh_) {
         DepthFootprint fp;
         ++f.stats.depthTests;
         const bool hidden = testedFootprint(f, ref, fp) && !fp.rect.empty() &&
                             (fp.centres.empty() || pyramid_.occluded(fp.centres, fp.nearest, params_.tuning.pyramidSpan));
         if (hidden) culledTriangles_ += subtreeTriangles(f, ref);
+        hiddenParts += hidden;
         history_.recordAnswer(history_.at(ref, f.objects), !hidden, f.index);
     }
+    // A probe's parts are every part drawn, not those drawn early: their rate is not the
+    // refresh's.
+    if (!f.probeAtEnd) learnOccludedRate(refreshOccludedRate_, hiddenParts, refresh_.size());
+    return true;
 }
 
 void QueryScheduler::testTriangles(Frame& f) {

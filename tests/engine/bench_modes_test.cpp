@@ -55,6 +55,8 @@ TEST(BenchModes, AblationsOfFullAndTheirVolumes) {
     EXPECT_TRUE(modeFromName("vfc-again")->scheduler.features.useClusters);
     EXPECT_TRUE(modeFromName("full")->scheduler.features.useEndProbes);
     EXPECT_FALSE(modeFromName("full-testprobe")->scheduler.features.useEndProbes);
+    EXPECT_TRUE(modeFromName("full")->scheduler.features.useRefreshPyramid);
+    EXPECT_FALSE(modeFromName("full-rasterrefresh")->scheduler.features.useRefreshPyramid);
     const ModeSpec k = modeFromName("full+kdop26").take();
     EXPECT_EQ(k.scheduler.mode, CullMode::TwoPhase);
     EXPECT_EQ(k.scheduler.tuning.volume, VolumeChoice::Kdop26);

@@ -252,6 +252,45 @@ TEST_F(ClusterHistory, TheRecordIsPricedFromCountsSoTwinsDecideAlike) {
     EXPECT_EQ(ctx_->checkErrors(), 0u);
 }
 
+TEST_F(ClusterHistory, TheRefreshSharesTheRecordsReadAndKeepsTheImage) {
+    // The parts drawn early are tested for next frame against the pyramid of the final
+    // depth that the record reads anyway (useRefreshPyramid), not in a batched raster test
+    // (the reference): vfc's image every frame, one batch a frame fewer, and no more
+    // depth reads. The pyramid's answer is coarser, so the early set may hold more.
+    build({2000, 8, 3.2f, 1.0f, {2.2f, 1.6f, 2.2f}});
+    if (HasFatalFailure()) return;
+    SchedulerParams pyramid = paramsOf(CullMode::TwoPhase, true), raster = pyramid;
+    ASSERT_TRUE(pyramid.features.useRefreshPyramid);
+    raster.features.useRefreshPyramid = false;
+    QueryScheduler a(pyramid), b(raster), vfc(paramsOf(CullMode::Vfc, true));
+    std::uint64_t batchesPyramid = 0, batchesRaster = 0, readsPyramid = 0, readsRaster = 0, earlyPyramid = 0, earlyRaster = 0;
+    for (int f = 0; f < 24; ++f) {
+        SCOPED_TRACE("frame " + std::to_string(f));
+        circle(0.12f * float(f), 8.0f, 1.0f);
+        Image images[3];
+        const FrameStats x = render(a, images[0]);
+        const FrameStats y = render(b, images[1]);
+        render(vfc, images[2]);
+        EXPECT_EQ(differingPixels(images[0], images[2]), 0u);
+        EXPECT_EQ(differingPixels(images[1], images[2]), 0u);
+        batchesPyramid += x.rasterBatches;
+        batchesRaster += y.rasterBatches;
+        readsPyramid += x.pyramidBuilds;
+        readsRaster += y.pyramidBuilds;
+        earlyPyramid += x.earlyTriangles;
+        earlyRaster += y.earlyTriangles;
+    }
+    std::printf("refresh on the record's pyramid: %llu raster batches against %llu, %llu depth reads against %llu, "
+                "%llu early triangles against %llu\n",
+                static_cast<unsigned long long>(batchesPyramid), static_cast<unsigned long long>(batchesRaster),
+                static_cast<unsigned long long>(readsPyramid), static_cast<unsigned long long>(readsRaster),
+                static_cast<unsigned long long>(earlyPyramid), static_cast<unsigned long long>(earlyRaster));
+    // A batch fewer in each frame with parts to refresh (history skips some frames' parts).
+    EXPECT_LT(batchesPyramid, batchesRaster);
+    EXPECT_LE(readsPyramid, readsRaster);
+    EXPECT_EQ(ctx_->checkErrors(), 0u);
+}
+
 TEST_F(ClusterCulling, PixelSizedClustersKeepTheImageExact) {
     // Spheres of one to a few pixels, so that most clusters cover a pixel centre or two, or
     // none: the depth-pyramid tests read only the pixels whose centres a box can cover

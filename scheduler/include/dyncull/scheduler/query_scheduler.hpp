@@ -132,6 +132,13 @@ struct SchedulerFeatures {
     /// scene with little to cull about 1.2-1.3x vfc's time (an ablation, bench mode
     /// full-testprobe).
     bool useEndProbes = true;
+    /// TwoPhase: where cluster history's record reads the final depth anyway, the parts
+    /// drawn early are tested for next frame against that read's pyramid (each volume as
+    /// the end probe tests it), not in a batched raster test: one readback and one batch a
+    /// frame fewer, for the pyramid's coarser answer (a part it cannot reject is only drawn
+    /// early next frame, never culled). Off: the batched raster test, exact per pixel (an
+    /// ablation, bench mode full-rasterrefresh).
+    bool useRefreshPyramid = true;
 };
 
 /// Approximate settings (Queries only). Each may drop visible pixels; `dyncull bench`
@@ -534,10 +541,12 @@ private:
     void refreshClusterPyramid(Frame& f);
     /// refresh_ tested against the final depth: a part hidden there is not drawn early next frame.
     void testRefresh(Frame& f);
-    /// The cost model's probe at the frame's end (SchedulerFeatures::useEndProbes): the
-    /// parts in refresh_ tested against a pyramid of the final depth, their answers
-    /// recorded and the hidden ones' triangles counted in culledTriangles_.
-    void probeFinalDepth(Frame& f);
+    /// refresh_ tested against a pyramid of the final depth (read here, once a frame: the
+    /// record uses it too), their answers recorded and the hidden ones' triangles counted
+    /// in culledTriangles_: the cost model's probe (SchedulerFeatures::useEndProbes), and
+    /// the refresh where the record reads the final depth anyway (useRefreshPyramid).
+    /// False if the depth could not be read (nothing recorded).
+    bool testOnFinalPyramid(Frame& f);
     /// True if a triangle test of `ref` is expected to save more drawing than it costs.
     bool worthTriangleTest(const Frame& f, NodeRef ref);
     /// Tests triangleTests_ (PartSink::testParts), draws the visible ones, records the answers.
