@@ -131,8 +131,7 @@ void QueryScheduler::recordVerdicts(const Frame& f, std::span<const NodeRef> par
 void QueryScheduler::recordClusterVisibility(Frame& f) {
     // The final depth holds every occluder the frame drew, so it hides the most clusters;
     // what it says only chooses next frame's early draws.
-    if (!f.finalPyramid && !buildPyramid(f)) return;  // the bits stay as they were
-    f.finalPyramid = true;
+    if (!readFinalPyramid(f)) return;  // the bits stay as they were
     const auto t1 = SchedulerClock::now();
     const SceneObjects& objs = f.objects;
     // All drawing is done, so the rasteriser's cores are free: with the worker, the later

@@ -113,9 +113,7 @@ void QueryScheduler::runTwoPhase(Frame& f) {
     if (!candidates_.empty()) testCandidates(f, triangles);
     if (!triangleTests_.empty()) testTriangles(f);
     if (triangles) readDrawMarks(f);
-    // The budget's early-set rule needs each part's samples, which only the raster test counts.
-    const bool refreshOnPyramid = params_.features.useRefreshPyramid && f.recordClusterBits && !f.markClusters &&
-                                  !(params_.approx.errorBudgetPercent > 0.0 && params_.approx.budgetEarlySet);
+    const bool refreshOnPyramid = params_.features.useRefreshPyramid && f.recordClusterBits && !f.markClusters && !budgetTakesEarlySet();
     if (f.probeAtEnd) {
         testOnFinalPyramid(f);
     } else if (!refresh_.empty() && !(refreshOnPyramid && testOnFinalPyramid(f))) {
@@ -369,7 +367,7 @@ void QueryScheduler::testRefresh(Frame& f) {
     // With an error budget, a part that shows so little that the budget could take it is
     // left out of next frame's early set, so that it is a candidate the budget may cull
     // then (drawn this frame, it costs no error now).
-    const bool budget = params_.approx.errorBudgetPercent > 0.0 && params_.approx.budgetEarlySet;
+    const bool budget = budgetTakesEarlySet();
     const std::uint64_t budgetPixels = errorBudgetPixels(f);
     rasterTest(f, refresh_, budget);
     learnOccludedRate(refreshOccludedRate_, rasterAnswers_);
@@ -381,14 +379,18 @@ void QueryScheduler::testRefresh(Frame& f) {
     }
 }
 
+bool QueryScheduler::readFinalPyramid(Frame& f) {
+    if (!f.finalPyramid) f.finalPyramid = buildPyramid(f);
+    return f.finalPyramid;
+}
+
 bool QueryScheduler::testOnFinalPyramid(Frame& f) {
     // A part drawn whose volume is behind the final depth would have been culled by a
     // frame that tests, or leaves the early set: what testing saves, as the late pass's
     // first test measures it. Its own fragments are in that depth, never behind its
     // volume's nearest point, so a part that shows is never called hidden.
     if (refresh_.empty()) return true;
-    if (!f.finalPyramid && !buildPyramid(f)) return false;
-    f.finalPyramid = true;
+    if (!readFinalPyramid(f)) return false;
     std::size_t hiddenParts = 0;
     for (const NodeRef ref : refresh_) {
         DepthFootprint fp;

@@ -213,9 +213,7 @@ TEST(NearFar, NearPlane1eMinus4WithFarPlane1e7MatchesTheLayeredReference) {
     // the pyramid, whose slack (DepthPyramid::kDepthSlack, 2^-16 of the depth) keeps a quad
     // 1e-5 of its distance behind another in the early set once it was drawn: drawn, never
     // lost (the image and the parts are checked above).
-    SchedulerParams exact;
-    exact.tuning.queryTimeoutMs = 20000.0;
-    exact.features.useCostModel = false;  // as the rig's full: tiny scene, the tests are what is checked
+    SchedulerParams exact = scene.rig.full.params();
     exact.features.useRefreshPyramid = false;
     QueryScheduler rasterRefresh(exact);
     for (int frame = 0; frame < 2; ++frame) {

@@ -541,8 +541,14 @@ private:
     void refreshClusterPyramid(Frame& f);
     /// refresh_ tested against the final depth: a part hidden there is not drawn early next frame.
     void testRefresh(Frame& f);
-    /// refresh_ tested against a pyramid of the final depth (read here, once a frame: the
-    /// record uses it too), their answers recorded and the hidden ones' triangles counted
+    /// The pyramid built from the frame's final depth, read at most once a frame (the
+    /// refresh and the record share it); false if the depth could not be read.
+    bool readFinalPyramid(Frame& f);
+    /// With an error budget that hands the early set to it (budgetEarlySet): the refresh
+    /// needs each part's samples, which only the batched raster test counts.
+    bool budgetTakesEarlySet() const { return params_.approx.errorBudgetPercent > 0.0 && params_.approx.budgetEarlySet; }
+    /// refresh_ tested against a pyramid of the final depth (readFinalPyramid: the record
+    /// uses it too), their answers recorded and the hidden ones' triangles counted
     /// in culledTriangles_: the cost model's probe (SchedulerFeatures::useEndProbes), and
     /// the refresh where the record reads the final depth anyway (useRefreshPyramid).
     /// False if the depth could not be read (nothing recorded).
