@@ -5,7 +5,8 @@
 // cone, the box's footprint (ScreenProjection::boxCentres) and the pyramid at span 32, on
 // boxes of 1 to 40 pixels seen through a rotated and scaled object matrix; its parts alone
 // are BM_ClusterCone and BM_ClusterFootprint. BM_ClusterRecord is cluster history's record
-// of one cluster at the frame's end.
+// of one cluster at the frame's end, and BM_ClusterRecordLearned the same for a cluster whose
+// footprint the late pass handed on (the pyramid alone).
 #include <benchmark/benchmark.h>
 
 #include <random>
@@ -161,6 +162,23 @@ void BM_ClusterRecord(benchmark::State& state) {
     state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * static_cast<std::int64_t>(s.clusters.size()));
 }
 BENCHMARK(BM_ClusterRecord);
+
+// The record of a cluster whose footprint the late pass's tests handed on: the pyramid at
+// span 16 alone.
+void BM_ClusterRecordLearned(benchmark::State& state) {
+    const ClusterScene s;
+    const ScreenProjection screen(s.view);
+    const ObjectProjection object = screen.objectProjection(s.matrix);
+    std::vector<ScreenRect> centres(s.clusters.size());
+    std::vector<float> nearest(s.clusters.size(), 0.0f);
+    for (std::size_t i = 0; i < s.clusters.size(); ++i) screen.boxCentres(object, s.clusters[i].box, centres[i], nearest[i]);
+    std::size_t hidden = 0;
+    for (auto _ : state)
+        for (std::size_t i = 0; i < centres.size(); ++i) hidden += centres[i].empty() || s.pyramid.occluded(centres[i], nearest[i], 16);
+    benchmark::DoNotOptimize(hidden);
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * static_cast<std::int64_t>(centres.size()));
+}
+BENCHMARK(BM_ClusterRecordLearned);
 
 }  // namespace
 

@@ -10,35 +10,40 @@
 // clusters: in the early pass those that showed last frame, in the late pass the others.
 
 #include <algorithm>
+#include <cassert>
 
 #include "cluster_selection.hpp"
 
 namespace dyncull {
 
 namespace {
-/// True if cluster `c` of an object with `matrix` (prepared as `object`) shows nothing:
+/// What clusterHidden found: hidden, reaching the near plane (shows), in front and not
+/// rejected (its footprint filled in), or neither (no pyramid to test against).
+enum class ClusterTest : std::uint8_t { Hidden, Crossing, Passed, Untested };
+
+/// Whether cluster `c` of an object with `matrix` (prepared as `object`) shows nothing:
 /// outside the frustum (if `frustum`: its part crosses it), or behind the depth pyramid (if
 /// `pyramid`). A cluster the eye is inside of or that reaches the near plane is visible
 /// (boxDepth says so); one off screen is not.
-bool clusterHidden(const QueryScheduler::Frame& f, const DepthPyramid* pyramid, int span, const glm::mat4& matrix,
-                   const ObjectProjection& object, const LeafCluster& c, bool frustum) {
-    if (frustum && f.frustum().outside(transformAabb(matrix, c.box))) return true;
-    if (!pyramid) return false;
-    ScreenRect centres;
-    float nearest = 0.0f;
-    if (!f.screen.boxCentres(object, c.box, centres, nearest)) return false;
+ClusterTest clusterTest(const QueryScheduler::Frame& f, const DepthPyramid* pyramid, int span, const glm::mat4& matrix,
+                        const ObjectProjection& object, const LeafCluster& c, bool frustum, ScreenRect& centres, float& nearest) {
+    if (frustum && f.frustum().outside(transformAabb(matrix, c.box))) return ClusterTest::Hidden;
+    if (!pyramid) return ClusterTest::Untested;
+    if (!f.screen.boxCentres(object, c.box, centres, nearest)) return ClusterTest::Crossing;
     // A pyramid exists only for a single-sample target: a cluster covering no pixel centre draws nothing.
-    return centres.empty() || pyramid->occluded(centres, nearest, span);
+    return centres.empty() || pyramid->occluded(centres, nearest, span) ? ClusterTest::Hidden : ClusterTest::Passed;
 }
 }  // namespace
 
-bool QueryScheduler::cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, const LocalBspNode& n, ClusterPass pass) {
+bool QueryScheduler::cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, const LocalBspNode& n, ClusterPass pass,
+                                  std::uint32_t recordIndex) {
     clusterRanges_.clear();
     clusterRangeIds_.clear();
     lastDeferred_ = 0;
     ClusterJob job;
     bool tested = false;
     if (!planClusters(f, ref, model, n, pass, job, tested)) return false;
+    if (pass == ClusterPass::Deferred) job.recordIndex = recordIndex;
     if (!selection_) selection_ = std::make_unique<ClusterSelection>();
     ClusterSelection& sel = *selection_;
     selectClusters(f, job, sel);
@@ -62,7 +67,11 @@ bool QueryScheduler::planClusters(Frame& f, NodeRef ref, const LocalBsp& model, 
     const std::span<const LeafCluster> clusters = model.clusters.ofSubtree(ref.node, n.subtreeSize);
     if (clusters.empty()) return false;
     const SceneObjects& objs = f.objects;
-    if (f.recordClusterBits && pass != ClusterPass::Deferred) clusterParts_.push_back(ref);  // its bits are written at the frame's end
+    if (f.recordClusterBits && pass != ClusterPass::Deferred) {  // its bits are written at the frame's end
+        job.recordIndex = static_cast<std::uint32_t>(clusterParts_.size());
+        clusterParts_.push_back(ref);
+        clusterPartLearned_.push_back(kInvalidIndex);
+    }
     // Which tests can cull anything here: cones only where back faces are culled, the
     // frustum only for a part crossing it, the pyramid only after the early pass.
     bool cones = model.faces == FaceMode::CullBack && f.sink.cullsBackFaces();
@@ -101,6 +110,8 @@ bool QueryScheduler::planClusters(Frame& f, NodeRef ref, const LocalBsp& model, 
     job.frustum = frustum;
     job.pyramid = pyramid;
     job.markRanges = f.markClusters;
+    // Only tests against a pyramid learn enough to spare the record a projection.
+    job.keepLearned = f.recordClusterBits && !f.markClusters && pyramid && params_.features.useLearnedClusters;
     return true;
 }
 
@@ -114,6 +125,8 @@ void QueryScheduler::selectClusters(const Frame& f, const ClusterJob& job, Clust
     const std::uint32_t firstCluster = job.firstBit;
     const std::span<const LeafCluster> clusters = job.clusters;
     const DepthPyramid* pyramid = job.pyramid ? &pyramid_ : nullptr;
+    out.learned.assign(job.keepLearned ? clusters.size() : 0, LearnedCluster{});
+    LearnedCluster scratch;
     // What the tests culled (less the gaps drawn after all) and, per run of undrawn
     // clusters since the last drawn one (gap*), what a merged range would draw.
     std::uint64_t gapTriangles = 0;
@@ -124,8 +137,19 @@ void QueryScheduler::selectClusters(const Frame& f, const ClusterJob& job, Clust
         // if it faces the eye and is in the frustum.
         const bool otherPass = job.split && clusterBit(job.shown, firstCluster + i) == (pass == ClusterPass::Deferred);
         const bool drawnEarly = pass == ClusterPass::Deferred && otherPass;
-        bool culled = !drawnEarly && job.cones && job.eye.backFacing(c);
-        if (!drawnEarly && !culled && (job.frustum || pyramid)) culled = clusterHidden(f, pyramid, params_.tuning.clusterPyramidSpan, job.matrix, job.object, c, job.frustum);
+        bool culled = false;
+        if (!drawnEarly) {
+            LearnedCluster& learned = job.keepLearned ? out.learned[i] : scratch;
+            ClusterTest test = job.cones && job.eye.backFacing(c) ? ClusterTest::Hidden : ClusterTest::Untested;
+            if (test == ClusterTest::Untested && (job.frustum || pyramid))
+                test = clusterTest(f, pyramid, params_.tuning.clusterPyramidSpan, job.matrix, job.object, c, job.frustum,
+                                   learned.centres, learned.nearest);
+            culled = test == ClusterTest::Hidden;
+            learned.fate = culled ? LearnedCluster::Fate::Hidden
+                           : test == ClusterTest::Crossing ? LearnedCluster::Fate::Crossing
+                           : test == ClusterTest::Passed   ? LearnedCluster::Fate::Projected
+                                                           : LearnedCluster::Fate::Untested;
+        }
         if (culled) {
             ++out.culledClusters;
             out.culledTriangles += c.indexCount / 3;
@@ -173,6 +197,13 @@ void QueryScheduler::takeSelection(Frame& f, const ClusterJob& job, ClusterSelec
     f.stats.clustersCulled += sel.culledClusters;
     f.stats.clusterTrianglesCulled += sel.culledTriangles;
     f.stats.clusterMs += sel.ms;
+    if (job.keepLearned && job.recordIndex != kInvalidIndex) {
+        assert(job.recordIndex < clusterPartLearned_.size() && sel.learned.size() == job.clusters.size());
+        // A part tested in both passes (early, then its deferred clusters) is learned from the
+        // deferred pass, the only one with a pyramid.
+        clusterPartLearned_[job.recordIndex] = static_cast<std::uint32_t>(learnedClusters_.size());
+        learnedClusters_.insert(learnedClusters_.end(), sel.learned.begin(), sel.learned.end());
+    }
     clusterRanges_.swap(sel.ranges);
     clusterRangeIds_.swap(sel.rangeIds);
 }

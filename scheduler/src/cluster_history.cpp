@@ -33,6 +33,7 @@ void QueryScheduler::startDeferredSelection(Frame& f) {
         bool tested = false;
         [[maybe_unused]] const bool planned = planClusters(f, ref, model, model.nodes[ref.node], ClusterPass::Deferred, job, tested);
         assert(planned && "a part that deferred clusters is drawn as clusters");
+        job.recordIndex = deferredParts_[i].recordIndex;
         // The words holding its bits, copied: the late pass may grow the history's storage.
         const std::size_t firstWord = job.firstBit / 64, endWord = (job.firstBit + job.clusters.size() + 63) / 64;
         bitOffsets[i] = d.bits.size();
@@ -75,7 +76,7 @@ void QueryScheduler::drawDeferredClusters(Frame& f) {
             takeSelection(f, selected->jobs[i], selected->out[i]);
         } else {
             const LocalBsp& model = objs.model(objs.modelOf(d.ref.object));
-            cullClusters(f, d.ref, model, model.nodes[d.ref.node], ClusterPass::Deferred);
+            cullClusters(f, d.ref, model, model.nodes[d.ref.node], ClusterPass::Deferred, d.recordIndex);
         }
         if (clusterRanges_.empty()) {
             // None of its clusters drawn in either pass: it was not drawn.
@@ -102,11 +103,14 @@ std::span<const LeafCluster> partClusters(const SceneObjects& objs, NodeRef ref)
 }
 }  // namespace
 
-void QueryScheduler::recordVerdicts(const Frame& f, std::span<const NodeRef> parts, bool sinkCullsBackFaces,
+void QueryScheduler::recordVerdicts(const Frame& f, std::size_t first, std::span<const NodeRef> parts, bool sinkCullsBackFaces,
                                     std::vector<std::uint8_t>& shown) const {
+    using Fate = LearnedCluster::Fate;
     const SceneObjects& objs = f.objects;
+    const int span = params_.tuning.recordPyramidSpan;
     shown.clear();
-    for (const NodeRef ref : parts) {
+    for (std::size_t p = 0; p < parts.size(); ++p) {
+        const NodeRef ref = parts[p];
         const LocalBsp& model = objs.model(objs.modelOf(ref.object));
         const std::span<const LeafCluster> clusters = partClusters(objs, ref);
         const glm::mat4& matrix = objs.matrix(ref.object);
@@ -115,14 +119,22 @@ void QueryScheduler::recordVerdicts(const Frame& f, std::span<const NodeRef> par
         // cone test is cheaper than the projection.
         const bool cones = model.faces == FaceMode::CullBack && sinkCullsBackFaces;
         const ObjectSpaceEye eye(f.camera(), matrix);
-        for (const LeafCluster& c : clusters) {
-            // No guarantee needed here (a deferred cluster is tested in the late pass), so
-            // the box is projected roughly: in float, without rounding margins.
-            ScreenRect centres;
-            float nearest = 1.0f;
-            const bool hidden = (cones && eye.backFacing(c)) ||
-                                (f.screen.roughBoxDepth(toClip, c.box, centres, nearest) &&
-                                 (centres.empty() || pyramid_.occluded(centres, nearest, params_.tuning.recordPyramidSpan)));
+        const std::uint32_t learnedAt = clusterPartLearned_[first + p];
+        const LearnedCluster* learned = learnedAt == kInvalidIndex ? nullptr : learnedClusters_.data() + learnedAt;
+        for (std::size_t i = 0; i < clusters.size(); ++i) {
+            const LeafCluster& c = clusters[i];
+            const Fate fate = learned ? learned[i].fate : Fate::Untested;
+            bool hidden = fate == Fate::Hidden;
+            if (fate == Fate::Projected) {
+                hidden = pyramid_.occluded(learned[i].centres, learned[i].nearest, span);
+            } else if (fate == Fate::Untested) {
+                // No guarantee needed here (a deferred cluster is tested in the late pass),
+                // so the box is projected roughly: in float, without rounding margins.
+                ScreenRect centres;
+                float nearest = 1.0f;
+                hidden = (cones && eye.backFacing(c)) ||
+                         (f.screen.roughBoxDepth(toClip, c.box, centres, nearest) && (centres.empty() || pyramid_.occluded(centres, nearest, span)));
+            }
             shown.push_back(hidden ? 0 : 1);
         }
     }
@@ -134,19 +146,35 @@ void QueryScheduler::recordClusterVisibility(Frame& f) {
     if (!readFinalPyramid(f)) return;  // the bits stay as they were
     const auto t1 = SchedulerClock::now();
     const SceneObjects& objs = f.objects;
-    // All drawing is done, so the rasteriser's cores are free: with the worker, the later
-    // parts (about half the clusters) are tested on a second thread. Each half writes its
-    // own verdicts; the bits are set after the join, since two parts of one object may
-    // share a word of them.
-    std::size_t split = clusterParts_.size();
-    std::size_t total = 0;
-    for (const NodeRef ref : clusterParts_) total += partClusters(objs, ref).size();
-    if (params_.features.useClusterWorker) {
-        if (total >= params_.tuning.recordWorkerClusters) {
-            std::size_t half = 0;
-            split = 0;
-            while (split < clusterParts_.size() && 2 * half < total) half += partClusters(objs, clusterParts_[split++]).size();
+    // Each part's share of the work, in ns of TestCosts: a cluster the frame's tests left
+    // untested is projected, one they projected only read again, one they hid costs nothing.
+    const TestCosts& costs = params_.tuning.costs;
+    recordPartNs_.assign(clusterParts_.size(), 0.0);
+    double totalNs = 0.0;
+    for (std::size_t p = 0; p < clusterParts_.size(); ++p) {
+        const std::size_t count = partClusters(objs, clusterParts_[p]).size();
+        std::size_t untested = count, projected = 0;
+        if (const std::uint32_t at = clusterPartLearned_[p]; at != kInvalidIndex) {
+            untested = projected = 0;
+            for (std::size_t i = 0; i < count; ++i) {
+                const LearnedCluster::Fate fate = learnedClusters_[at + i].fate;
+                untested += fate == LearnedCluster::Fate::Untested;
+                projected += fate == LearnedCluster::Fate::Projected;
+            }
         }
+        f.stats.clustersLearned += static_cast<std::uint32_t>(count - untested);
+        recordPartNs_[p] = double(untested) * costs.recordNsPerCluster + double(projected) * costs.recordNsPerLearned;
+        totalNs += recordPartNs_[p];
+    }
+    // All drawing is done, so the rasteriser's cores are free: with the worker, the later
+    // parts (about half the work) are tested on a second thread. Each half writes its own
+    // verdicts; the bits are set after the join, since two parts of one object may share a
+    // word of them.
+    std::size_t split = clusterParts_.size();
+    if (params_.features.useClusterWorker && totalNs >= double(params_.tuning.recordWorkerClusters) * costs.recordNsPerCluster) {
+        double half = 0.0;
+        split = 0;
+        while (split < clusterParts_.size() && 2.0 * half < totalNs) half += recordPartNs_[split++];
     }
     const std::span<const NodeRef> parts(clusterParts_);
     const bool cullsBackFaces = f.sink.cullsBackFaces();
@@ -154,13 +182,13 @@ void QueryScheduler::recordClusterVisibility(Frame& f) {
     if (split < clusterParts_.size()) {
         try {
             worker = std::thread([this, &f, parts, split, cullsBackFaces] {
-                recordVerdicts(f, parts.subspan(split), cullsBackFaces, recordShownLate_);
+                recordVerdicts(f, split, parts.subspan(split), cullsBackFaces, recordShownLate_);
             });
         } catch (const std::system_error&) {
             split = clusterParts_.size();  // no thread to be had: all on this one
         }
     }
-    recordVerdicts(f, parts.first(split), cullsBackFaces, recordShown_);
+    recordVerdicts(f, 0, parts.first(split), cullsBackFaces, recordShown_);
     if (worker.joinable()) {
         worker.join();
         recordShown_.insert(recordShown_.end(), recordShownLate_.begin(), recordShownLate_.end());
@@ -180,7 +208,7 @@ void QueryScheduler::recordClusterVisibility(Frame& f) {
     // Timed, it swung with the frame (a wait for the drawing, a thread descheduled on two
     // cores), and one slow frame turned the record off until the next probe.
     const double threads = split < clusterParts_.size() ? 2.0 : 1.0;
-    clusterRecordNs_ = params_.tuning.costs.pyramidNs + double(total) * params_.tuning.costs.recordNsPerCluster / threads;
+    clusterRecordNs_ = costs.pyramidNs + totalNs / threads;
     lastClusterRecordFrame_ = f.index;
 }
 

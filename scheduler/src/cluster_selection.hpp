@@ -27,12 +27,34 @@ struct QueryScheduler::ClusterJob {
     bool split = false;    ///< early or deferred: the bits divide the clusters between passes
     bool cones = false, frustum = false, pyramid = false;  ///< the tests to run
     bool markRanges = false;  ///< one range per cluster, never merged (marked clusters)
+    /// With cluster history's record this frame: the tests keep what they learn of each
+    /// cluster (ClusterSelection::learned), for the record to take rather than project
+    /// the cluster again; and the part's entry in clusterParts_ that it goes to.
+    bool keepLearned = false;
+    std::uint32_t recordIndex = kInvalidIndex;
+};
+
+/// What a cluster's tests learned this frame, handed on to cluster history's record at the
+/// frame's end. Depth only grows nearer within a frame, and the camera and objects hold
+/// still, so a cluster facing away, outside the frustum or behind an earlier pyramid is
+/// hidden in the final depth too; one in front of the near plane keeps its footprint.
+struct QueryScheduler::LearnedCluster {
+    enum class Fate : std::uint8_t {
+        Untested,   ///< not tested this frame (drawn early, or tests off): the record projects it
+        Hidden,     ///< facing away, outside the frustum, or behind an earlier pyramid
+        Crossing,   ///< reaches the near plane or holds the eye: shows
+        Projected,  ///< in front, not rejected: `centres` and `nearest` are its footprint
+    };
+    ScreenRect centres;     ///< window pixels whose centres it may cover (Projected)
+    float nearest = 0.0f;   ///< its nearest window depth, reversed Z (Projected)
+    Fate fate = Fate::Untested;
 };
 
 /// What they decided: the ranges to draw and the counts the stats and cost models take.
 struct QueryScheduler::ClusterSelection {
     std::vector<IndexRange> ranges;
     std::vector<std::uint32_t> rangeIds;  ///< with markRanges: each range's cluster (model index)
+    std::vector<LearnedCluster> learned;  ///< with keepLearned: one per cluster of the job, in order
     std::uint64_t culledTriangles = 0, deferredTriangles = 0, drawnTriangles = 0;
     std::uint32_t culledClusters = 0, deferred = 0, drawn = 0;
     double ms = 0.0;  ///< spent testing

@@ -235,7 +235,10 @@ void QueryScheduler::drawNode(Frame& f, NodeRef ref, bool untested, ClusterPass 
         // none is drawn now.
         const bool traced = f.trace && !f.trace->empty() && f.trace->back().ref == ref;
         const std::uint32_t entry = traced ? static_cast<std::uint32_t>(f.trace->size() - 1) : kInvalidIndex;
-        deferredParts_.push_back({ref, !clusterRanges_.empty(), entry});
+        // Its early cull pushed it last onto clusterParts_, where the record finds it.
+        assert(!f.recordClusterBits || (!clusterParts_.empty() && clusterParts_.back() == ref));
+        const std::uint32_t recordIndex = f.recordClusterBits ? static_cast<std::uint32_t>(clusterParts_.size() - 1) : kInvalidIndex;
+        deferredParts_.push_back({ref, !clusterRanges_.empty(), entry, recordIndex});
         if (clusterRanges_.empty()) return;
     }
     if (clustered && clusterRanges_.empty()) {

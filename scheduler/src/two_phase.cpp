@@ -56,6 +56,8 @@ void QueryScheduler::runTwoPhase(Frame& f) {
     // last frame (cluster history).
     deferredParts_.clear();
     clusterParts_.clear();
+    clusterPartLearned_.clear();
+    learnedClusters_.clear();
     deferredTriangles_ = 0;
     const bool clusterHistory =
         testing && params_.features.useClusterHistory && params_.features.useClusters && !triangles && f.sink.drawsRanges();

@@ -57,6 +57,8 @@ TEST(BenchModes, AblationsOfFullAndTheirVolumes) {
     EXPECT_FALSE(modeFromName("full-testprobe")->scheduler.features.useEndProbes);
     EXPECT_TRUE(modeFromName("full")->scheduler.features.useRefreshPyramid);
     EXPECT_FALSE(modeFromName("full-rasterrefresh")->scheduler.features.useRefreshPyramid);
+    EXPECT_TRUE(modeFromName("full")->scheduler.features.useLearnedClusters);
+    EXPECT_FALSE(modeFromName("full-ownrecord")->scheduler.features.useLearnedClusters);
     const ModeSpec k = modeFromName("full+kdop26").take();
     EXPECT_EQ(k.scheduler.mode, CullMode::TwoPhase);
     EXPECT_EQ(k.scheduler.tuning.volume, VolumeChoice::Kdop26);

@@ -200,10 +200,51 @@ TEST_F(ClusterHistory, TheWorkerDecidesAsTheRenderThreadDoes) {
         EXPECT_EQ(x.clustersCulled, y.clustersCulled);
         EXPECT_EQ(x.clusterTrianglesCulled, y.clusterTrianglesCulled);
         EXPECT_EQ(x.clusterTests, y.clusterTests);
+        EXPECT_EQ(x.clustersLearned, y.clustersLearned);
         EXPECT_EQ(differingPixels(images[0], images[1]), 0u);
         deferredDrawn += x.deferredClustersDrawn;
     }
     EXPECT_GT(deferredDrawn, 0u) << "the late pass drew no deferred cluster: the worker was never compared";
+    EXPECT_EQ(ctx_->checkErrors(), 0u);
+}
+
+TEST_F(ClusterHistory, TheRecordTakesWhatTheFramesTestsLearned) {
+    // The frame-end record takes the verdicts and footprints of the clusters the late pass
+    // tested against an earlier pyramid (useLearnedClusters, the default) instead of
+    // projecting them again (the reference): vfc's image every frame either way, and in
+    // every frame that drew deferred clusters the record learned some. A cluster hidden by
+    // an earlier pyramid is hidden in the final depth too, and a footprint in double is no
+    // coarser than the record's own in float, so the early sets stay as small (the pyramid
+    // levels the two read may differ: within 2%).
+    build({2000, 8, 3.2f, 1.0f, {2.2f, 1.6f, 2.2f}});
+    if (HasFatalFailure()) return;
+    SchedulerParams learning = paramsOf(CullMode::TwoPhase, true), own = learning;
+    ASSERT_TRUE(learning.features.useLearnedClusters);
+    own.features.useLearnedClusters = false;
+    QueryScheduler a(learning), b(own), vfc(paramsOf(CullMode::Vfc, true));
+    std::uint64_t learned = 0, earlyLearning = 0, earlyOwn = 0;
+    for (int f = 0; f < 24; ++f) {
+        SCOPED_TRACE("frame " + std::to_string(f));
+        circle(0.12f * float(f), 8.0f, 1.0f);
+        Image images[3];
+        const FrameStats x = render(a, images[0]);
+        const FrameStats y = render(b, images[1]);
+        render(vfc, images[2]);
+        EXPECT_EQ(differingPixels(images[0], images[2]), 0u);
+        EXPECT_EQ(differingPixels(images[1], images[2]), 0u);
+        EXPECT_EQ(y.clustersLearned, 0u);
+        if (x.deferredClustersDrawn > 0) {
+            EXPECT_GT(x.clustersLearned, 0u);
+        }
+        learned += x.clustersLearned;
+        earlyLearning += x.earlyTriangles;
+        earlyOwn += y.earlyTriangles;
+    }
+    std::printf("record with learned clusters: %llu learned; early triangles %llu against %llu projecting every cluster\n",
+                static_cast<unsigned long long>(learned), static_cast<unsigned long long>(earlyLearning),
+                static_cast<unsigned long long>(earlyOwn));
+    EXPECT_GT(learned, 0u);
+    EXPECT_LE(double(earlyLearning), 1.02 * double(earlyOwn));
     EXPECT_EQ(ctx_->checkErrors(), 0u);
 }
 

@@ -38,6 +38,10 @@ struct FrameStats {
     /// the late pass drew (the pyramid could not reject them).
     std::uint32_t clustersDeferred = 0;
     std::uint32_t deferredClustersDrawn = 0;
+    /// Two-phase with cluster history's record: clusters whose verdict the record took from
+    /// the frame's own cluster tests (SchedulerFeatures::useLearnedClusters) rather than
+    /// projecting them again.
+    std::uint32_t clustersLearned = 0;
     double clusterMs = 0.0;             ///< CPU in the cluster tests, and in the final-depth tests of cluster history
     std::uint64_t queryTriangles = 0;   ///< triangles of the query volumes drawn (12 per box)
     std::uint32_t queriesOccluded = 0;  ///< answered "occluded"

@@ -139,6 +139,13 @@ struct SchedulerFeatures {
     /// early next frame, never culled). Off: the batched raster test, exact per pixel (an
     /// ablation, bench mode full-rasterrefresh).
     bool useRefreshPyramid = true;
+    /// TwoPhase with cluster history's record: the record takes what the frame's own
+    /// cluster tests learned (a cluster facing away, outside the frustum or behind an
+    /// earlier pyramid is hidden in the final depth too, since depth only grows nearer; one
+    /// that passed keeps its footprint) and projects only the clusters nobody tested, those
+    /// drawn early. Off: the record projects every cluster again (an ablation, bench mode
+    /// full-ownrecord).
+    bool useLearnedClusters = true;
 };
 
 /// Approximate settings (Queries only). Each may drop visible pixels; `dyncull bench`
@@ -210,8 +217,10 @@ inline std::uint64_t errorBudgetPixels(double percent, int width, int height) {
 /// 60% on the bunny path), are worth more drawing than `pyramidNs`, a depth read that
 /// waits for nothing and the build (`bench_volume_tests`, `bench_depth_pyramid`). Cluster
 /// history's record at the frame's end is priced the same: `pyramidNs` plus
-/// `recordNsPerCluster` per cluster it tests (`BM_ClusterRecord`), over the threads that
-/// share them (counts, not its time: a timed price swung with the frame).
+/// `recordNsPerCluster` per cluster it projects (`BM_ClusterRecord`) and
+/// `recordNsPerLearned` per cluster whose footprint the frame's own tests handed it
+/// (`BM_ClusterRecordLearned`), over the threads that share them (counts, not its time: a
+/// timed price swung with the frame).
 struct TestCosts {
     double drawNsPerTriangle = 53.0;
     double testNsPerVolume = 2700.0;
@@ -220,6 +229,7 @@ struct TestCosts {
     double triangleTestNsPerTriangle = 69.0;
     double clusterTestNs = 90.0;
     double recordNsPerCluster = 118.0;
+    double recordNsPerLearned = 40.0;
     double drawNsPerRange = 0.0;
     double depthReadNs = 400000.0;
     double pyramidNs = 180000.0;
@@ -292,8 +302,9 @@ struct SchedulerTuning {
     /// the test; splitting them off costs a sync only where the backend would overlap.
     bool splitDrawWaits = false;
     /// With useClusterWorker: cluster history's record at the frame's end shares its tests
-    /// with a second thread from this many clusters (a thread costs tens of microseconds to
-    /// start).
+    /// with a second thread from the work of this many clusters to project (the clusters
+    /// the frame's tests handed on count at TestCosts::recordNsPerLearned against
+    /// recordNsPerCluster; a thread costs tens of microseconds to start).
     std::uint32_t recordWorkerClusters = 4096;
     TestCosts costs;
 };
@@ -602,13 +613,17 @@ private:
     /// the survivors in clusterRanges_ (adjacent ones merged, unless the frame marks
     /// clusters: then one range per cluster, its index in clusterRangeIds_); false if the
     /// part is to be drawn whole.
-    bool cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, const LocalBspNode& n, ClusterPass pass);
+    /// `recordIndex`: for a deferred pass, the part's entry in clusterParts_ (the early
+    /// pass's), which its tests' LearnedCluster go to.
+    bool cullClusters(Frame& f, NodeRef ref, const LocalBsp& model, const LocalBspNode& n, ClusterPass pass,
+                      std::uint32_t recordIndex = kInvalidIndex);
     // The steps of cullClusters (cluster_selection.hpp): which tests, decided on the render
     // thread (false: the part is drawn whole); the tests, safe on any thread; their counts
     // into the stats and cost model.
     struct ClusterJob;
     struct ClusterSelection;
     struct DeferredSelection;
+    struct LearnedCluster;
     /// Whether part `ref` of `model` is drawn as clusters (useClusters, a sink that draws
     /// ranges, a model with clusters), whatever the tests then decide.
     bool drawsAsClusters(const Frame& f, NodeRef ref, const LocalBsp& model) const;
@@ -627,11 +642,17 @@ private:
     // clusters were drawn or tested this frame (their bits are written at the frame's end).
     struct DeferredPart {
         NodeRef ref;
-        bool drawn;           ///< some of its clusters were drawn early
-        std::uint32_t trace;  ///< its entry in the frame's trace, or kInvalidIndex
+        bool drawn;                 ///< some of its clusters were drawn early
+        std::uint32_t trace;        ///< its entry in the frame's trace, or kInvalidIndex
+        std::uint32_t recordIndex;  ///< its entry in clusterParts_, or kInvalidIndex
     };
     std::vector<DeferredPart> deferredParts_;
     std::vector<NodeRef> clusterParts_;
+    // SchedulerFeatures::useLearnedClusters: for each entry of clusterParts_, the offset of
+    // its clusters' LearnedCluster in learnedClusters_ (kInvalidIndex: none tested this
+    // frame); written as the tests are taken, read by the record.
+    std::vector<std::uint32_t> clusterPartLearned_;
+    std::vector<LearnedCluster> learnedClusters_;
     std::uint32_t lastDeferred_ = 0;  // clusters the last cullClusters call deferred
     /// Cluster history's cost model: this frame's deferred triangles that the late pass did
     /// not draw, the drawing they saved the last frame that used bits (ns), the last
@@ -648,8 +669,11 @@ private:
     void recordClusterVisibility(Frame& f);
     /// The record's verdicts for `parts`' clusters in order, 1 where a cluster shows: reads
     /// only the frame, the pyramid and the objects, so two threads can share the parts.
-    void recordVerdicts(const Frame& f, std::span<const NodeRef> parts, bool sinkCullsBackFaces, std::vector<std::uint8_t>& shown) const;
+    /// `first`: the index in clusterParts_ of `parts`' first (their LearnedCluster).
+    void recordVerdicts(const Frame& f, std::size_t first, std::span<const NodeRef> parts, bool sinkCullsBackFaces,
+                        std::vector<std::uint8_t>& shown) const;
     std::vector<std::uint8_t> recordShown_, recordShownLate_;
+    std::vector<double> recordPartNs_;  // each of clusterParts_' share of the record (TestCosts, ns)
     // useClusterMarks: the cluster each range of clusterRanges_ is (its index in its
     // model's clusters), and every cluster drawn this frame in the order its mark comes back.
     struct MarkedCluster {
