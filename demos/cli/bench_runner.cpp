@@ -311,7 +311,7 @@ std::string sweepParamsHelp() {
     return "pixel-threshold, max-skip, skip-per-visible, small-feature, max-in-flight, tile-size, auto-saving (percent), "
            "latency (0 or 1 frames); error-budget (full; percent of the frame's pixels, decimals allowed); pyramid-span (full; "
            "texels a side of the late pass's pyramid tests, 2 to 64); cluster-span (full; the same for cluster tests); record-span (full; the same for cluster history's frame-end record); candidate-rounds (full; rounds of the late pass's raster tests, 1 to 16); test-ns (full; the cost model's nanoseconds per batched volume "
-           "test, TestCosts::testNsPerVolume); pyramid-ns (full; the cost model's nanoseconds per pyramid built again before a round, "
+           "test, TestCosts::testNsPerVolume); batch-ns (full; the cost model's nanoseconds per round of raster tests before its first volume, TestCosts::testNsPerBatch, 0 for every round); pyramid-ns (full; the cost model's nanoseconds per pyramid built again before a round, "
            "TestCosts::pyramidNs); record-worker (full; clusters from which cluster history's frame-end record shares its tests with a second thread, SchedulerTuning::recordWorkerClusters); submit-tris (full; triangles drawn between two glFlush calls, EngineOptions::submitTriangles, 0 for none)";
 }
 
@@ -368,6 +368,9 @@ Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec) {
         } else if (param == "submit-tris") {
             m.scheduler.mode = CullMode::TwoPhase;
             m.submitTriangles = v;
+        } else if (param == "batch-ns") {
+            m.scheduler.mode = CullMode::TwoPhase;
+            m.scheduler.tuning.costs.testNsPerBatch = double(v);
         } else if (param == "test-ns") {
             m.scheduler.mode = CullMode::TwoPhase;
             m.scheduler.tuning.costs.testNsPerVolume = double(v);

@@ -60,9 +60,12 @@ Status validateSchedulerParams(const SchedulerParams& p) {
     if (!(p.tuning.frontPercent >= 0.0f && p.tuning.frontPercent <= 100.0f)) return Error{"frontPercent must be in [0, 100]"};
     if (!(p.tuning.autoVolumeSaving >= 0.0f && p.tuning.autoVolumeSaving <= 1.0f)) return Error{"autoVolumeSaving must be in [0, 1]"};
     if (static_cast<int>(p.tuning.volume) > static_cast<int>(VolumeChoice::Auto)) return Error{"volume has an unknown value"};
-    for (double c : {p.tuning.costs.drawNsPerTriangle, p.tuning.costs.testNsPerVolume, p.tuning.costs.testNsPerPixel, p.tuning.costs.depthReadNs,
-                     p.tuning.costs.triangleTestNsPerPart, p.tuning.costs.triangleTestNsPerTriangle})
+    const TestCosts& costs = p.tuning.costs;
+    for (double c : {costs.drawNsPerTriangle, costs.testNsPerVolume, costs.testNsPerPixel, costs.testNsPerBatch, costs.depthReadNs,
+                     costs.triangleTestNsPerPart, costs.triangleTestNsPerTriangle, costs.clusterTestNs, costs.recordNsPerCluster,
+                     costs.recordNsPerLearned, costs.drawNsPerRange, costs.pyramidNs})
         if (!(c >= 0.0 && c < 1e12)) return Error{"costs must be finite and non-negative (nanoseconds)"};
+    if (!(costs.roundPyramidCulls >= 0.0 && costs.roundPyramidCulls <= 1.0)) return Error{"costs.roundPyramidCulls must be in [0, 1] (a share)"};
     if (!(p.approx.errorBudgetPercent >= 0.0 && p.approx.errorBudgetPercent <= 100.0))
         return Error{"errorBudgetPercent must be in [0, 100] (percent of the frame's pixels)"};
     if (p.tuning.costs.probeFrames == 0) return Error{"costs.probeFrames must be at least 1"};

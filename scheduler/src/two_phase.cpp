@@ -29,6 +29,7 @@
 // has (the early parts are drawn, and depth only grows nearer afterwards).
 #include <algorithm>
 #include <cassert>
+#include <cmath>
 
 #include "cluster_selection.hpp"
 
@@ -96,6 +97,7 @@ void QueryScheduler::runTwoPhase(Frame& f) {
 
     // 3. Late pass.
     candidates_.clear();
+    candidateMarginNs_ = 0.0;
     refresh_.clear();
     triangleTests_.clear();
     if (!(root == NodeRef{})) {
@@ -251,8 +253,10 @@ void QueryScheduler::lateTraversal(Frame& f, bool testing, bool haveDepth, bool 
             } else {
                 refresh_.push_back(ref);
             }
-        } else if (raster && !certain && (worthTesting(f, ref, rect, candidateOccludedRate_) || exploring(ref))) {
+        } else if (const double margin = raster && !certain ? testMarginNs(f, ref, rect, candidateOccludedRate_) : 0.0;
+                   raster && !certain && (!params_.features.useCostModel || margin > 0.0 || exploring(ref))) {
             candidates_.push_back(ref);
+            candidateMarginNs_ += std::max(margin, 0.0);  // an exploring part rides along where the round pays
         } else {
             if (raster && !certain) ++f.stats.skippedByCost;
             note(certain ? NodeState::VisibleNear : testing && !raster ? NodeState::VisibleQueried : NodeState::VisibleCheaper);
@@ -277,8 +281,18 @@ void QueryScheduler::testCandidates(Frame& f, bool triangles) {
     const bool budget = params_.approx.errorBudgetPercent > 0.0;
     if (!budget) {
         // In rounds, front to back (the traversal's order): a later round is tested against
-        // the depth of the earlier rounds' visible parts too.
-        const std::size_t rounds = std::min<std::size_t>(params_.tuning.candidateRounds, candidates_.size());
+        // the depth of the earlier rounds' visible parts too; as many as pay.
+        const std::size_t rounds = candidateRoundsPaid(f);
+        if (rounds == 0) {
+            // Cheaper drawn than tested: settled as if every answer were "visible", so they
+            // are drawn and tested for next frame against the final depth.
+            f.stats.skippedByCost += static_cast<std::uint32_t>(candidates_.size());
+            rasterAnswers_.assign(candidates_.size(), QueryResult::Visible);
+            budgetCulled_.assign(candidates_.size(), kBudgetNo);
+            settleCandidates(f, triangles, false);
+            return;
+        }
+        lastCandidateBatchFrame_ = f.index;
         allCandidates_.swap(candidates_);
         for (std::size_t r = 0; r < rounds; ++r) {
             const std::size_t begin = allCandidates_.size() * r / rounds, end = allCandidates_.size() * (r + 1) / rounds;
@@ -334,7 +348,16 @@ void QueryScheduler::refreshClusterPyramid(Frame& f) {
     f.clusterPyramid = buildPyramid(f);
 }
 
-void QueryScheduler::settleCandidates(Frame& f, bool triangles) {
+std::size_t QueryScheduler::candidateRoundsPaid(const Frame& f) const {
+    const std::size_t rounds = std::min<std::size_t>(params_.tuning.candidateRounds, candidates_.size());
+    const TestCosts& c = params_.tuning.costs;
+    if (!params_.features.useCostModel || c.testNsPerBatch == 0.0) return rounds;
+    const double paid = std::floor(candidateMarginNs_ / c.testNsPerBatch);
+    if (paid >= 1.0) return std::min(rounds, static_cast<std::size_t>(std::min(paid, double(rounds))));
+    return f.index - lastCandidateBatchFrame_ >= c.probeFrames ? 1 : 0;
+}
+
+void QueryScheduler::settleCandidates(Frame& f, bool triangles, bool tested) {
     const SceneObjects& objs = f.objects;
     const std::uint64_t trianglesBefore = f.stats.trianglesDrawn;
     for (std::size_t i = 0; i < candidates_.size(); ++i) {
@@ -356,7 +379,7 @@ void QueryScheduler::settleCandidates(Frame& f, bool triangles) {
             const LocalBspNode& n = objs.model(objs.modelOf(ref.object)).nodes[ref.node];
             triangleTests_.push_back({ref, n.firstIndex, n.indexCount});
         } else {
-            f.note(ref, NodeState::VisibleQueried);
+            f.note(ref, tested ? NodeState::VisibleQueried : NodeState::VisibleCheaper);
             drawNode(f, ref, false);
             if (!triangles) refresh_.push_back(candidates_[i]);  // may be hidden by parts drawn after it
         }
@@ -460,10 +483,13 @@ bool QueryScheduler::worthTriangleTest(const Frame& f, NodeRef ref) {
     return triangleOccludedRate_ * triangles * c.drawNsPerTriangle > c.triangleTestNsPerPart + triangles * c.triangleTestNsPerTriangle;
 }
 
-bool QueryScheduler::worthTesting(const Frame& f, NodeRef ref, const ScreenRect& rect, double occludedRate) {
-    if (!params_.features.useCostModel) return true;
+double QueryScheduler::testMarginNs(const Frame& f, NodeRef ref, const ScreenRect& rect, double occludedRate) {
     const TestCosts& c = params_.tuning.costs;
-    return occludedRate * double(subtreeTriangles(f, ref)) * c.drawNsPerTriangle > c.testNsPerVolume + c.testNsPerPixel * rect.area();
+    return occludedRate * double(subtreeTriangles(f, ref)) * c.drawNsPerTriangle - (c.testNsPerVolume + c.testNsPerPixel * rect.area());
+}
+
+bool QueryScheduler::worthTesting(const Frame& f, NodeRef ref, const ScreenRect& rect, double occludedRate) {
+    return !params_.features.useCostModel || testMarginNs(f, ref, rect, occludedRate) > 0.0;
 }
 
 std::uint64_t QueryScheduler::subtreeTriangles(const Frame& f, NodeRef ref) {

@@ -1281,6 +1281,50 @@ TEST(TwoPhaseCosts, PartsAreTestedOnlyWhereTheTestPays) {
     }
 }
 
+// A round of raster tests costs TestCosts::testNsPerBatch before its first volume: the
+// late pass's candidates get a round only where their summed margins pay for it, else they
+// are drawn untested, except every probeFrames frames, which keeps their rate measured.
+// The far row is hidden, and only a raster test can say so.
+TEST(TwoPhaseCosts, ARoundOfRasterTestsIsIssuedOnlyWhereItsCandidatesPayForIt) {
+    TestScene s(4, 3);
+    TwoLevelTree tree(s.bsp, s.objects);
+    for (const double batchNs : {0.0, 1e11}) {
+        SCOPED_TRACE("testNsPerBatch " + std::to_string(batchNs));
+        DepthBackend backend;
+        backend.rule = [](const QueryVolume& v) {
+            float zMax = -1e30f;
+            for (const glm::vec3& q : v.points()) zMax = std::max(zMax, q.z);
+            return zMax < -6.0f ? QueryResult::Occluded : QueryResult::Visible;
+        };
+        SchedulerParams p = twoPhase();
+        p.tuning.costs.drawNsPerTriangle = 1e6;  // every part alone is worth a test
+        p.tuning.costs.testNsPerBatch = batchNs;
+        p.tuning.costs.probeFrames = 4;
+        QueryScheduler sched(p);
+        int culling = 0, firstCulling = -1;
+        for (int f = 0; f < 6; ++f) {
+            SCOPED_TRACE("frame " + std::to_string(f));
+            RecordingSink sink;
+            const FrameStats st = sched.cullFrame(tree, frontCamera(), 640, 320, backend, sink);
+            // A frame whose candidates were tested culls the far row; one that drew them
+            // untested counts them skipped by the cost model.
+            ASSERT_TRUE(sink.drawn.size() == 8u || sink.drawn.size() == 12u);
+            if (sink.drawn.size() == 8u) {
+                ++culling;
+                if (firstCulling < 0) firstCulling = f;
+            } else {
+                EXPECT_GE(st.skippedByCost, 4u);
+            }
+        }
+        if (batchNs == 0.0) {
+            EXPECT_EQ(culling, 6);
+        } else {
+            EXPECT_EQ(culling, 1) << "the probe alone";
+            EXPECT_GE(firstCulling, 3) << "after probeFrames frames";
+        }
+    }
+}
+
 // The first frame has no early depth: in full-hzb (no final-depth test) it measures no
 // saving, and must not switch the tests off for it.
 TEST(TwoPhaseCosts, AFrameWithoutEarlyDepthDoesNotTurnTheTestsOff) {

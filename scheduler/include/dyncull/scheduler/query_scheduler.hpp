@@ -195,7 +195,10 @@ inline std::uint64_t errorBudgetPixels(double percent, int width, int height) {
 /// pixel of its screen rectangle; what it saves is the part's triangles times
 /// `drawNsPerTriangle`, times the measured rate at which such tests answer "occluded"
 /// (kept per kind: parts new this frame, and parts drawn early being tested again).
-/// Otherwise the part is simply drawn. The same model turns a frame's tests off (no
+/// Otherwise the part is simply drawn. A round of raster tests also costs
+/// `testNsPerBatch` before its first volume (a sync with the GL and a readback,
+/// `bench_volume_tests`), so a frame's candidates get only the rounds their summed
+/// margins pay for, and none if they do not pay for one. The same model turns a frame's tests off (no
 /// depth readback, no test: every part in the frustum drawn) while the last frame
 /// tested culled less drawing than `depthReadNs`, the readback and the stall it causes
 /// (the late pass cannot start before the early pass is rasterised); it tests again
@@ -225,6 +228,7 @@ struct TestCosts {
     double drawNsPerTriangle = 53.0;
     double testNsPerVolume = 2700.0;
     double testNsPerPixel = 1.5;
+    double testNsPerBatch = 200000.0;
     double triangleTestNsPerPart = 0.0;
     double triangleTestNsPerTriangle = 69.0;
     double clusterTestNs = 90.0;
@@ -514,6 +518,13 @@ private:
     // has tens of thousands of candidates.
     std::vector<NodeRef> candidates_, refresh_;
     std::vector<NodeRef> allCandidates_;  // every candidate while they are tested in rounds
+    double candidateMarginNs_ = 0.0;      // this frame's candidates' testMarginNs, summed
+    std::uint32_t lastCandidateBatchFrame_ = 0;  // the last frame whose candidates were raster-tested
+    /// How many rounds of raster tests this frame's candidates get: candidateRounds (at
+    /// most one per candidate), fewer where their summed margins do not pay for each
+    /// round's TestCosts::testNsPerBatch, 0 if not one (then they are drawn untested),
+    /// but 1 every probeFrames frames so the rate of occluded answers stays measured.
+    std::size_t candidateRoundsPaid(const Frame& f) const;
     /// The volume `ref` is tested with in two-phase (world space): its world box for a
     /// scene node or without tight volumes, else its own volume under its object's matrix.
     QueryVolume testedVolume(const Frame& f, NodeRef ref) const;
@@ -577,8 +588,11 @@ private:
     /// Triangles under `ref`: its subtree's for an object node, its objects' for a scene node.
     std::uint64_t subtreeTriangles(const Frame& f, NodeRef ref);
     std::vector<std::uint32_t> scratchIndices_;  // subtreeTriangles' stack
-    /// True if testing part `ref`, whose volume covers `rect`, is expected to save more
-    /// drawing than it costs, given that a fraction `occludedRate` of such tests cull.
+    /// What testing part `ref`, whose volume covers `rect`, is expected to save in drawing
+    /// less what the test costs (ns, TestCosts), given that a fraction `occludedRate` of
+    /// such tests cull; the batch's own cost (testNsPerBatch) is not in it.
+    double testMarginNs(const Frame& f, NodeRef ref, const ScreenRect& rect, double occludedRate);
+    /// True if testMarginNs is positive (always, without the cost model).
     bool worthTesting(const Frame& f, NodeRef ref, const ScreenRect& rect, double occludedRate);
     /// True for the new parts tested this frame whatever the cost model expects.
     bool exploring(NodeRef ref) const;
@@ -601,8 +615,9 @@ private:
     enum : std::uint8_t { kBudgetNo, kBudgetCulled, kBudgetLater };
     std::vector<std::uint8_t> budgetCulled_;
     std::vector<NodeRef> waitingParts_;
-    /// Culls, draws or hands on to triangle tests each candidate by its answer.
-    void settleCandidates(Frame& f, bool triangles);
+    /// Culls, draws or hands on to triangle tests each candidate by its answer (all
+    /// "visible" if not `tested`: the cost model drew them untested).
+    void settleCandidates(Frame& f, bool triangles, bool tested = true);
     std::vector<std::pair<double, std::uint32_t>> budgetOrder_;  // (drawing saved per sample, candidate)
 
     // useClusters (cluster_culling.cpp): the ranges of the part being drawn, and per model
