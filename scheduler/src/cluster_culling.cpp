@@ -17,7 +17,7 @@
 namespace dyncull {
 
 namespace {
-/// What clusterHidden found: hidden, reaching the near plane (shows), in front and not
+/// What clusterTest found: hidden, reaching the near plane (shows), in front and not
 /// rejected (its footprint filled in), or neither (no pyramid to test against).
 enum class ClusterTest : std::uint8_t { Hidden, Crossing, Passed, Untested };
 

@@ -353,7 +353,7 @@ std::size_t QueryScheduler::candidateRoundsPaid(const Frame& f) const {
     const TestCosts& c = params_.tuning.costs;
     if (!params_.features.useCostModel || c.testNsPerBatch == 0.0) return rounds;
     const double paid = std::floor(candidateMarginNs_ / c.testNsPerBatch);
-    if (paid >= 1.0) return std::min(rounds, static_cast<std::size_t>(std::min(paid, double(rounds))));
+    if (paid >= 1.0) return static_cast<std::size_t>(std::min(paid, double(rounds)));
     return f.index - lastCandidateBatchFrame_ >= c.probeFrames ? 1 : 0;
 }
 
