@@ -91,11 +91,14 @@ protected:
         return st.ok() ? *st : FrameStats{};
     }
 
-    /// An ablation's check: `on` (a feature's default) and `off` (without it) each draw
-    /// vfc's image in each of `frames` frames, the camera stepping `step` radians round
-    /// the ring; `each(x, y)` takes both frames' stats.
+    /// An ablation's check: two-phase with clusters with `feature` on (its default) and
+    /// off each draw vfc's image in each of `frames` frames, the camera stepping `step`
+    /// radians round the ring; `each(x, y)` takes both frames' stats (on, off).
     template <class Each>
-    void onOffAgainstVfc(const SchedulerParams& on, const SchedulerParams& off, int frames, float step, Each each) {
+    void onOffAgainstVfc(bool SchedulerFeatures::*feature, int frames, float step, Each each) {
+        SchedulerParams on = paramsOf(CullMode::TwoPhase, true), off = on;
+        ASSERT_TRUE(on.features.*feature) << "the feature is on by default";
+        off.features.*feature = false;
         QueryScheduler a(on), b(off), vfc(paramsOf(CullMode::Vfc, true));
         for (int f = 0; f < frames; ++f) {
             SCOPED_TRACE("frame " + std::to_string(f));
@@ -238,11 +241,8 @@ TEST_F(ClusterHistory, TheRecordTakesWhatTheFramesTestsLearned) {
     // levels the two read may differ: within 2%).
     build({2000, 8, 3.2f, 1.0f, {2.2f, 1.6f, 2.2f}});
     if (HasFatalFailure()) return;
-    SchedulerParams learning = paramsOf(CullMode::TwoPhase, true), own = learning;
-    ASSERT_TRUE(learning.features.useLearnedClusters);
-    own.features.useLearnedClusters = false;
     std::uint64_t learned = 0, earlyLearning = 0, earlyOwn = 0;
-    onOffAgainstVfc(learning, own, 24, 0.12f, [&](const FrameStats& x, const FrameStats& y) {
+    onOffAgainstVfc(&SchedulerFeatures::useLearnedClusters, 24, 0.12f, [&](const FrameStats& x, const FrameStats& y) {
         EXPECT_EQ(y.clustersLearned, 0u);
         if (x.deferredClustersDrawn > 0) {
             EXPECT_GT(x.clustersLearned, 0u);
@@ -310,11 +310,8 @@ TEST_F(ClusterHistory, TheRefreshSharesTheRecordsReadAndKeepsTheImage) {
     // depth reads. The pyramid's answer is coarser, so the early set may hold more.
     build({2000, 8, 3.2f, 1.0f, {2.2f, 1.6f, 2.2f}});
     if (HasFatalFailure()) return;
-    SchedulerParams pyramid = paramsOf(CullMode::TwoPhase, true), raster = pyramid;
-    ASSERT_TRUE(pyramid.features.useRefreshPyramid);
-    raster.features.useRefreshPyramid = false;
     std::uint64_t batchesPyramid = 0, batchesRaster = 0, readsPyramid = 0, readsRaster = 0, earlyPyramid = 0, earlyRaster = 0;
-    onOffAgainstVfc(pyramid, raster, 24, 0.12f, [&](const FrameStats& x, const FrameStats& y) {
+    onOffAgainstVfc(&SchedulerFeatures::useRefreshPyramid, 24, 0.12f, [&](const FrameStats& x, const FrameStats& y) {
         batchesPyramid += x.rasterBatches;
         batchesRaster += y.rasterBatches;
         readsPyramid += x.pyramidBuilds;
@@ -365,11 +362,8 @@ TEST_F(ClusterHistory, RoundPyramidsKeepTheImageAndCullMore) {
     // pass's: the same image as without, and as vfc's, every frame, with fewer triangles.
     build({2000, 8, 3.2f, 1.0f, {2.2f, 1.6f, 2.2f}});
     if (HasFatalFailure()) return;
-    SchedulerParams round = paramsOf(CullMode::TwoPhase, true), early = round;
-    ASSERT_TRUE(round.features.useRoundPyramids);
-    early.features.useRoundPyramids = false;
     std::uint64_t drawnRound = 0, drawnEarly = 0, extraBuilds = 0;
-    onOffAgainstVfc(round, early, 24, 0.25f, [&](const FrameStats& x, const FrameStats& y) {
+    onOffAgainstVfc(&SchedulerFeatures::useRoundPyramids, 24, 0.25f, [&](const FrameStats& x, const FrameStats& y) {
         drawnRound += x.trianglesDrawn;
         drawnEarly += y.trianglesDrawn;
         extraBuilds += x.pyramidBuilds - y.pyramidBuilds;

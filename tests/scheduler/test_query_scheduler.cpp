@@ -1036,6 +1036,14 @@ SchedulerParams twoPhase() {
     return p;
 }
 
+/// TestScene(_, 3)'s farthest row (z = -7) is hidden, the others visible: what only a
+/// raster test can say, since the backend's depth hides nothing.
+QueryResult farRowHidden(const QueryVolume& v) {
+    float zMax = -1e30f;
+    for (const glm::vec3& q : v.points()) zMax = std::max(zMax, q.z);
+    return zMax < -6.0f ? QueryResult::Occluded : QueryResult::Visible;
+}
+
 }  // namespace
 
 // With candidateRounds 2 the late pass's candidates are tested in two batches, the nearer
@@ -1048,12 +1056,7 @@ TEST(TwoPhaseRounds, NearerCandidatesAreTestedAndDrawnBeforeTheFartherHalf) {
         std::vector<std::string> events;
         std::vector<float> batchNearest;  // per batch: its nearest volume's distance along -Z
         std::vector<float> batchFarthest;
-        // The farthest row is hidden: only a test can say so.
-        backend.rule = [&](const QueryVolume& v) {
-            float zMax = -1e30f;
-            for (const glm::vec3& q : v.points()) zMax = std::max(zMax, q.z);
-            return zMax < -6.0f ? QueryResult::Occluded : QueryResult::Visible;
-        };
+        backend.rule = farRowHidden;
         struct Sink final : PartSink {
             std::vector<std::string>* events = nullptr;
             std::multiset<std::uint32_t> drawn;
@@ -1120,11 +1123,7 @@ TEST(TwoPhaseStats, SplitDrawWaitsWaitsBeforeEveryReadAndTestAndDecidesAlike) {
     std::multiset<std::uint32_t> drawn[2];
     for (const bool split : {false, true}) {
         DepthBackend backend;
-        backend.rule = [](const QueryVolume& v) {
-            float zMax = -1e30f;
-            for (const glm::vec3& q : v.points()) zMax = std::max(zMax, q.z);
-            return zMax < -6.0f ? QueryResult::Occluded : QueryResult::Visible;
-        };
+        backend.rule = farRowHidden;
         SchedulerParams p = twoPhase();
         p.features.useCostModel = false;
         p.tuning.splitDrawWaits = split;
@@ -1291,11 +1290,7 @@ TEST(TwoPhaseCosts, ARoundOfRasterTestsIsIssuedOnlyWhereItsCandidatesPayForIt) {
     for (const double batchNs : {0.0, 1e11}) {
         SCOPED_TRACE("testNsPerBatch " + std::to_string(batchNs));
         DepthBackend backend;
-        backend.rule = [](const QueryVolume& v) {
-            float zMax = -1e30f;
-            for (const glm::vec3& q : v.points()) zMax = std::max(zMax, q.z);
-            return zMax < -6.0f ? QueryResult::Occluded : QueryResult::Visible;
-        };
+        backend.rule = farRowHidden;
         SchedulerParams p = twoPhase();
         p.tuning.costs.drawNsPerTriangle = 1e6;  // every part alone is worth a test
         p.tuning.costs.testNsPerBatch = batchNs;
