@@ -79,7 +79,7 @@ bool applyTwoPhaseName(const std::string& part, ModeSpec& m) {
     if (part != "full" && part != "full-hzb" && part != "full-nohist" && part != "full-nocost" && part != "full-tri" &&
         part != "full-noclusters" && part != "full-noclusterhist" && part != "full-markclusterhist" && part != "full-noworker" &&
         part != "full-ring" && part != "full-splitwaits" && part != "full-noroundpyramid" &&
-        part != "full-nosubmit" && part != "full-testprobe" && part != "full-rasterrefresh" && part != "full-ownrecord")
+        part != "full-nosubmit" && part != "full-testprobe" && part != "full-rasterrefresh" && part != "full-ownrecord" && part != "full-notexel")
         return false;
     m.scheduler.mode = CullMode::TwoPhase;
     m.scheduler.features.useBatchedRaster = part != "full-hzb";
@@ -103,6 +103,7 @@ bool applyTwoPhaseName(const std::string& part, ModeSpec& m) {
     m.scheduler.features.useEndProbes = part != "full-testprobe";
     m.scheduler.features.useRefreshPyramid = part != "full-rasterrefresh";
     m.scheduler.features.useLearnedClusters = part != "full-ownrecord";
+    if (part == "full-notexel") m.scheduler.tuning.texelTestTexels = m.scheduler.tuning.clusterTexelTests = 0;
     return true;
 }
 
@@ -113,7 +114,7 @@ std::string modeNamesHelp() {
            "queries (hardware occlusion queries with history, batching and occupancy maps; the default before two-phase), oracle (the visible parts, whole), oracle-clusters (only their clusters that own a pixel), "
            "oracle-boxes (every cluster whose box passes against the final depth: the floor of a cluster-box culler; measures --volume-bound), "
            "oracle-budgetP (oracle-clusters less what an oracle with a budget of P% of the pixels leaves out); "
-           "ablations of full: full-hzb (the pyramid alone), full-tri (every part whose volume passes then tested on its own triangles, and draws marked), full-nohist (every part drawn early tested again each frame), full-nocost (every volume the pyramid lets through tested), full-noclusters (parts drawn whole, no cluster tests), full-noclusterhist (early parts drawn with all their clusters, not only those that showed last frame), full-markclusterhist (which clusters showed judged by their fragments' marks when drawn, not by their boxes against the final depth), full-noworker (the deferred clusters tested on the render thread as they are drawn, not ahead of them on a worker), full-ring (every volume's outline widened by a ring, boxes not grown across the view), full-noroundpyramid (the clusters of parts drawn after a raster test tested against the early pass's pyramid, not one built again before their round), full-splitwaits (full, measuring: waits for the drawing apart before each depth read and raster test, and times the pyramid tests: the Cheap tests table's own cost per test), full-nosubmit (full with its drawing handed to the GPU only where it reads something back, not every EngineOptions::submitTriangles triangles), full-testprobe (the cost model's probe, while tests are off, a frame that tests rather than a test of the frame's parts against its final depth), full-rasterrefresh (the parts drawn early tested for next frame by a batched raster test against the final depth, not against the pyramid of the final depth that cluster history's record reads), full-ownrecord (cluster history's record projects every cluster again, not taking what the frame's own cluster tests learned); "
+           "ablations of full: full-hzb (the pyramid alone), full-tri (every part whose volume passes then tested on its own triangles, and draws marked), full-nohist (every part drawn early tested again each frame), full-nocost (every volume the pyramid lets through tested), full-noclusters (parts drawn whole, no cluster tests), full-noclusterhist (early parts drawn with all their clusters, not only those that showed last frame), full-markclusterhist (which clusters showed judged by their fragments' marks when drawn, not by their boxes against the final depth), full-noworker (the deferred clusters tested on the render thread as they are drawn, not ahead of them on a worker), full-ring (every volume's outline widened by a ring, boxes not grown across the view), full-noroundpyramid (the clusters of parts drawn after a raster test tested against the early pass's pyramid, not one built again before their round), full-splitwaits (full, measuring: waits for the drawing apart before each depth read and raster test, and times the pyramid tests: the Cheap tests table's own cost per test), full-nosubmit (full with its drawing handed to the GPU only where it reads something back, not every EngineOptions::submitTriangles triangles), full-testprobe (the cost model's probe, while tests are off, a frame that tests rather than a test of the frame's parts against its final depth), full-rasterrefresh (the parts drawn early tested for next frame by a batched raster test against the final depth, not against the pyramid of the final depth that cluster history's record reads), full-ownrecord (cluster history's record projects every cluster again, not taking what the frame's own cluster tests learned), full-notexel (no per-texel tests: a volume or cluster the pyramid test at its span lets through is not tested again texel by texel against its front faces' planes); "
            "vfc-noclusters (vfc drawing parts whole), vfc-again (vfc a second time, among the other modes: the noise floor of a ratio to vfc); "
            "approximate full: budgetP (at most P percent of the frame's pixels lost, e.g. budget0.1), budgetearlyP (and early-set parts showing less than the budget handed to it), budgetrecountP (the parts that could fit drawn last, counted again against the depth of the rest); "
            "settings of queries: approximate thrN (pixel threshold), latency1 (last frame's results), "
@@ -310,7 +311,7 @@ Expected<std::vector<ModeSpec>> modesFromList(const std::string& list) {
 std::string sweepParamsHelp() {
     return "pixel-threshold, max-skip, skip-per-visible, small-feature, max-in-flight, tile-size, auto-saving (percent), "
            "latency (0 or 1 frames); error-budget (full; percent of the frame's pixels, decimals allowed); pyramid-span (full; "
-           "texels a side of the late pass's pyramid tests, 2 to 64); cluster-span (full; the same for cluster tests); record-span (full; the same for cluster history's frame-end record); candidate-rounds (full; rounds of the late pass's raster tests, 1 to 16); test-ns (full; the cost model's nanoseconds per batched volume "
+           "texels a side of the late pass's pyramid tests, 2 to 64); cluster-span (full; the same for cluster tests); record-span (full; the same for cluster history's frame-end record); texel-tests (full; texels the late pass's per-texel test reads at most, 0 for off); cluster-texel-tests (full; the same for cluster tests); candidate-rounds (full; rounds of the late pass's raster tests, 1 to 16); test-ns (full; the cost model's nanoseconds per batched volume "
            "test, TestCosts::testNsPerVolume); batch-ns (full; the cost model's nanoseconds per round of raster tests before its first volume, TestCosts::testNsPerBatch, 0 for every round); pyramid-ns (full; the cost model's nanoseconds per pyramid built again before a round, "
            "TestCosts::pyramidNs); record-worker (full; clusters from which cluster history's frame-end record shares its tests with a second thread, SchedulerTuning::recordWorkerClusters); submit-tris (full; triangles drawn between two glFlush calls, EngineOptions::submitTriangles, 0 for none)";
 }
@@ -350,6 +351,12 @@ Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec) {
         } else if (param == "pyramid-span") {
             m.scheduler.mode = CullMode::TwoPhase;
             m.scheduler.tuning.pyramidSpan = static_cast<int>(std::min<std::uint32_t>(v, 1u << 20));
+        } else if (param == "texel-tests") {
+            m.scheduler.mode = CullMode::TwoPhase;
+            m.scheduler.tuning.texelTestTexels = static_cast<int>(std::min<std::uint32_t>(v, 1u << 20));
+        } else if (param == "cluster-texel-tests") {
+            m.scheduler.mode = CullMode::TwoPhase;
+            m.scheduler.tuning.clusterTexelTests = static_cast<int>(std::min<std::uint32_t>(v, 1u << 20));
         } else if (param == "candidate-rounds") {
             m.scheduler.mode = CullMode::TwoPhase;
             m.scheduler.tuning.candidateRounds = v;

@@ -216,7 +216,7 @@ const char* frameStatsCsvHeader() {
            "nodes_visited,batches,parts,triangles,query_triangles,draw_queries,draw_queries_occluded,draw_queries_late,"
            "depth_tests,ms_depth_read,raster_tests,raster_batches,ms_raster,triangle_tests,ms_triangle_test,draw_marks_hidden,"
            "cluster_tests,clusters_culled,cluster_triangles_culled,clusters_deferred,deferred_clusters_drawn,ms_clusters,budget_culled,claimed_error_pixels,claim_unbounded,"
-           "early_triangles,tested_triangles,pyramid_builds,ms_draw_wait,ms_pyramid_tests,draw_submits,clusters_learned";
+           "early_triangles,tested_triangles,pyramid_builds,ms_draw_wait,ms_pyramid_tests,draw_submits,clusters_learned,texel_occluded";
 }
 
 void writeFrameStatsCsv(std::ostream& f, const FrameStats& s) {
@@ -230,7 +230,7 @@ void writeFrameStatsCsv(std::ostream& f, const FrameStats& s) {
       << s.triangleTestMs << ',' << s.drawMarksHidden << ',' << s.clusterTests << ',' << s.clustersCulled << ','
       << s.clusterTrianglesCulled << ',' << s.clustersDeferred << ',' << s.deferredClustersDrawn << ',' << s.clusterMs << ',' << s.budgetCulled << ',' << s.claimedErrorPixels << ','
       << (s.claimUnbounded ? 1 : 0) << ',' << s.earlyTriangles << ',' << s.testedTriangles << ',' << s.pyramidBuilds << ',' << s.drawWaitMs << ','
-      << s.pyramidTestMs << ',' << s.drawSubmits << ',' << s.clustersLearned;
+      << s.pyramidTestMs << ',' << s.drawSubmits << ',' << s.clustersLearned << ',' << s.texelOccluded;
 }
 
 Status writeFramesCsv(const BenchResult& r, const fs::path& path) {

@@ -23,15 +23,18 @@ enum class ClusterTest : std::uint8_t { Hidden, Crossing, Passed, Untested };
 
 /// Whether cluster `c` of an object with `matrix` (prepared as `object`) shows nothing:
 /// outside the frustum (if `frustum`: its part crosses it), or behind the depth pyramid (if
-/// `pyramid`). A cluster the eye is inside of or that reaches the near plane is visible
-/// (boxDepth says so); one off screen is not.
-ClusterTest clusterTest(const QueryScheduler::Frame& f, const DepthPyramid* pyramid, int span, const glm::mat4& matrix,
+/// `pyramid`: at `span`, then texel by texel reading at most `texels`, 0 for not). A
+/// cluster the eye is inside of or that reaches the near plane is visible (boxDepth says
+/// so); one off screen is not.
+ClusterTest clusterTest(const QueryScheduler::Frame& f, const DepthPyramid* pyramid, int span, int texels, const glm::mat4& matrix,
                         const ObjectProjection& object, const LeafCluster& c, bool frustum, ScreenRect& centres, float& nearest) {
     if (frustum && f.frustum().outside(transformAabb(matrix, c.box))) return ClusterTest::Hidden;
     if (!pyramid) return ClusterTest::Untested;
-    if (!f.screen.boxCentres(object, c.box, centres, nearest)) return ClusterTest::Crossing;
+    DepthPlanes planes;
+    if (!f.screen.boxCentres(object, c.box, centres, nearest, texels > 0 ? &planes : nullptr)) return ClusterTest::Crossing;
     // A pyramid exists only for a single-sample target: a cluster covering no pixel centre draws nothing.
-    return centres.empty() || pyramid->occluded(centres, nearest, span) ? ClusterTest::Hidden : ClusterTest::Passed;
+    if (centres.empty() || pyramid->occluded(centres, nearest, span)) return ClusterTest::Hidden;
+    return texels > 0 && pyramid->occludedPerTexel(centres, nearest, planes, texels) ? ClusterTest::Hidden : ClusterTest::Passed;
 }
 }  // namespace
 
@@ -142,7 +145,7 @@ void QueryScheduler::selectClusters(const Frame& f, const ClusterJob& job, Clust
             LearnedCluster& learned = job.keepLearned ? out.learned[i] : scratch;
             ClusterTest test = job.cones && job.eye.backFacing(c) ? ClusterTest::Hidden : ClusterTest::Untested;
             if (test == ClusterTest::Untested && (job.frustum || pyramid))
-                test = clusterTest(f, pyramid, params_.tuning.clusterPyramidSpan, job.matrix, job.object, c, job.frustum,
+                test = clusterTest(f, pyramid, params_.tuning.clusterPyramidSpan, params_.tuning.clusterTexelTests, job.matrix, job.object, c, job.frustum,
                                    learned.centres, learned.nearest);
             culled = test == ClusterTest::Hidden;
             learned.fate = culled ? LearnedCluster::Fate::Hidden

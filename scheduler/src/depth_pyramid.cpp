@@ -19,6 +19,23 @@ bool clampRect(const ScreenRect& rect, int width, int height, int& x0, int& y0, 
     return x0 <= x1 && y0 <= y1;
 }
 
+// The greatest depth the least of `p`'s planes takes over the centres of pixels
+// [x0, x1] x [y0, y1] grown by kSnapPixels (an affine function peaks at a corner), and at
+// most `nearest`.
+double boundOver(const DepthPlanes& p, float nearest, int x0, int y0, int x1, int y1) {
+    constexpr double s = DepthPyramid::kSnapPixels;
+    const double lx = x0 + 0.5 - s, hx = x1 + 0.5 + s, ly = y0 + 0.5 - s, hy = y1 + 0.5 + s;
+    double bound = nearest;
+    for (std::uint32_t i = 0; i < p.count; ++i) {
+        const auto& [a, b, c] = p.planes[i];
+        bound = std::min(bound, c + a * (a > 0.0 ? hx : lx) + b * (b > 0.0 ? hy : ly));
+    }
+    return bound;
+}
+
+// Reversed Z: behind means smaller, by more than the slack (as hiddenAt compares).
+bool behind(double bound, float t) { return bound < double(t - DepthPyramid::kDepthSlack * t); }
+
 }  // namespace
 
 void DepthPyramid::build(std::span<const float> depth, int width, int height) {
@@ -124,6 +141,52 @@ bool DepthPyramid::hiddenAt(int level, int x0, int y0, int x1, int y1, float nea
             if (!(nearestDepth < t - kDepthSlack * t)) return false;
         }
     }
+    return true;
+}
+
+bool DepthPyramid::occludedPerTexel(const ScreenRect& rect, float nearestDepth, const DepthPlanes& planes, int maxTexels) const {
+    int x0, y0, x1, y1;
+    if (levels_.empty() || !clampRect(rect, width_, height_, x0, y0, x1, y1)) return false;  // no evidence
+    assert(maxTexels >= 1);
+    // Depth first from the level where the rectangle spans at most 2 texels a side: each
+    // texel popped pushes at most four, so the stack holds at most 4 + 3 per level.
+    struct Texel {
+        int level, x, y;
+    };
+    std::array<Texel, 4 + 3 * 32> stack;
+    std::size_t top = 0;
+    const int start = levelSpanning(x0, y0, x1, y1, 2);
+    for (int ty = y0 >> start; ty <= (y1 >> start); ++ty)
+        for (int tx = x0 >> start; tx <= (x1 >> start); ++tx) stack[top++] = {start, tx, ty};
+    int visited = 0;
+    while (top > 0) {
+        const Texel t = stack[--top];
+        // The texel's pixels within the rectangle.
+        const int px0 = std::max(x0, t.x << t.level), px1 = std::min(x1, ((t.x + 1) << t.level) - 1);
+        const int py0 = std::max(y0, t.y << t.level), py1 = std::min(y1, ((t.y + 1) << t.level) - 1);
+        const Level& l = levels_[static_cast<std::size_t>(t.level)];
+        const float farthest = levelData(static_cast<std::size_t>(t.level))[static_cast<std::size_t>(t.y) * static_cast<std::size_t>(l.width) + static_cast<std::size_t>(t.x)];
+        if (behind(boundOver(planes, nearestDepth, px0, py0, px1, py1), farthest)) continue;
+        if (t.level == 0 || ++visited >= maxTexels) return false;
+        const int k = t.level - 1;
+        for (int cy = py0 >> k; cy <= (py1 >> k); ++cy)
+            for (int cx = px0 >> k; cx <= (px1 >> k); ++cx) {
+                assert(top < stack.size());
+                stack[top++] = {k, cx, cy};
+            }
+    }
+    return true;
+}
+
+bool occludedPerPixelBruteForce(std::span<const float> depth, int width, int height, const ScreenRect& rect, float nearestDepth,
+                                const DepthPlanes& planes) {
+    int x0, y0, x1, y1;
+    if (!clampRect(rect, width, height, x0, y0, x1, y1)) return false;
+    for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x) {
+            const float d = depth[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)];
+            if (!behind(boundOver(planes, nearestDepth, x, y, x, y), d)) return false;
+        }
     return true;
 }
 

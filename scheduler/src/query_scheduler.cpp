@@ -70,6 +70,8 @@ Status validateSchedulerParams(const SchedulerParams& p) {
         return Error{"errorBudgetPercent must be in [0, 100] (percent of the frame's pixels)"};
     if (p.tuning.costs.probeFrames == 0) return Error{"costs.probeFrames must be at least 1"};
     if (p.tuning.pyramidSpan < 2 || p.tuning.pyramidSpan > 64) return Error{"pyramidSpan must be in [2, 64] (texels)"};
+    if (p.tuning.texelTestTexels < 0 || p.tuning.texelTestTexels > 65536) return Error{"texelTestTexels must be in [0, 65536]"};
+    if (p.tuning.clusterTexelTests < 0 || p.tuning.clusterTexelTests > 65536) return Error{"clusterTexelTests must be in [0, 65536]"};
     if (p.tuning.candidateRounds < 1 || p.tuning.candidateRounds > 16) return Error{"candidateRounds must be in [1, 16]"};
     if (p.tuning.clusterPyramidSpan < 2 || p.tuning.clusterPyramidSpan > 64)
         return Error{"clusterPyramidSpan must be in [2, 64] (texels)"};

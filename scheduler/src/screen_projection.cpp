@@ -90,9 +90,9 @@ ScreenRect ScreenProjection::pixelRect(const glm::dvec2& lo, const glm::dvec2& h
 }
 
 ScreenRect ScreenProjection::centreRect(const glm::dvec2& lo, const glm::dvec2& hi) const {
-    // Pixel i's centre is at i + 0.5 in window coordinates. kSnap: a rasteriser snaps vertices
-    // to its sub-pixel grid, at least 4 bits in GL (SUBPIXEL_BITS), so by at most 1/32 pixel.
-    constexpr double kSnap = 1.0 / 16.0;
+    // Pixel i's centre is at i + 0.5 in window coordinates, and a rasteriser's snapping may
+    // move a vertex across it (DepthPyramid::kSnapPixels).
+    constexpr double kSnap = DepthPyramid::kSnapPixels;
     const double fx = 0.5 * view_.width, fy = 0.5 * view_.height;
     const int w = view_.width, h = view_.height;
     return {ceilIn((lo.x + 1.0) * fx - 0.5 - kSnap, 0, w), ceilIn((lo.y + 1.0) * fy - 0.5 - kSnap, 0, h),
@@ -145,11 +145,18 @@ ObjectProjection ScreenProjection::objectProjection(const glm::mat4& matrix) con
     p.toClip = view_.viewProjRelative * relative;
     for (int j = 0; j < 4; ++j) p.toDistance[j] = glm::dot(distanceRow_, relative[j]);
     p.absLinear = glm::dmat3(glm::abs(c0), glm::abs(c1), glm::abs(c2));
+    // In orthographic views the faces a box shows depend on the view direction, not the
+    // eye's position: no planes there.
+    if (det > 0.0 && !view_.camera.orthographic()) {
+        const glm::dmat3 linear(c0, c1, c2);
+        p.eyeLocal = glm::inverse(linear) * (glm::dvec3(view_.camera.position) - glm::dvec3(p.toWorld[3]));
+        p.eyeKnown = true;
+    }
     return p;
 }
 
 ScreenProjection::BoxNdc ScreenProjection::boxNdc(const ObjectProjection& object, const Aabb& local, glm::dvec2& ndcLo, glm::dvec2& ndcHi,
-                                                  double& nearestDepth) const {
+                                                  double& nearestDepth, DepthPlanes* planes) const {
     // QueryVolume::enlargedForRounding for a box: its vertices' magnitude sets the margin,
     // and each face is pushed out by it through a scale about the centre by k.
     const glm::dvec3 lo(local.min), hi(local.max);
@@ -182,6 +189,7 @@ ScreenProjection::BoxNdc ScreenProjection::boxNdc(const ObjectProjection& object
     ndcLo = glm::dvec2(1e300);
     ndcHi = glm::dvec2(-1e300);
     nearestDepth = 0.0;
+    std::array<glm::dvec3, 8> window;  // x, y in NDC, then window depth
     for (int i = 0; i < 8; ++i) {
         const glm::dvec4 clip = c + ((i & 1) ? p0 : -p0) + ((i & 2) ? p1 : -p1) + ((i & 4) ? p2 : -p2);
         const double inv = 1.0 / clip.w;
@@ -189,16 +197,49 @@ ScreenProjection::BoxNdc ScreenProjection::boxNdc(const ObjectProjection& object
         ndcLo = glm::min(ndcLo, ndc);
         ndcHi = glm::max(ndcHi, ndc);
         nearestDepth = std::max(nearestDepth, clip.z * inv);
+        window[static_cast<std::size_t>(i)] = {ndc, clip.z * inv};
     }
+    if (planes) frontFacePlanes(object, centre, k * half, window, *planes);
     return BoxNdc::InFront;
+}
+
+void ScreenProjection::frontFacePlanes(const ObjectProjection& object, const glm::dvec3& centre, const glm::dvec3& half,
+                                       const std::array<glm::dvec3, 8>& corners, DepthPlanes& out) const {
+    // A face is front-facing when the eye lies outside its plane, judged in object space
+    // with a margin of 2^-20 of the magnitudes (far above the rounding of the inverse): a
+    // back face taken for a front one would bound the depth by the box's far side, so
+    // a face too close to call is left out.
+    out.count = 0;
+    if (!object.eyeKnown) return;
+    const double fx = 0.5 * view_.width, fy = 0.5 * view_.height;
+    for (int a = 0; a < 3; ++a) {
+        const double outside = std::abs(object.eyeLocal[a] - centre[a]) - half[a];
+        if (!(outside > 0x1p-20 * (std::abs(object.eyeLocal[a]) + std::abs(centre[a]) + half[a]))) continue;
+        // Three corners of the face the eye is outside of: its plane's depth through them.
+        const int base = object.eyeLocal[a] > centre[a] ? 1 << a : 0;
+        const int b = 1 << ((a + 1) % 3), c = 1 << ((a + 2) % 3);
+        const glm::dvec3& q0 = corners[static_cast<std::size_t>(base)];
+        const glm::dvec3& q1 = corners[static_cast<std::size_t>(base | b)];
+        const glm::dvec3& q2 = corners[static_cast<std::size_t>(base | c)];
+        const double x0 = (q0.x + 1.0) * fx, y0 = (q0.y + 1.0) * fy;
+        const double dx1 = (q1.x - q0.x) * fx, dy1 = (q1.y - q0.y) * fy, dd1 = q1.z - q0.z;
+        const double dx2 = (q2.x - q0.x) * fx, dy2 = (q2.y - q0.y) * fy, dd2 = q2.z - q0.z;
+        // Seen nearly edge-on, the plane's slopes are ill-conditioned: left out when the
+        // face's projected area is below 2^-20 of its terms'.
+        const double det = dx1 * dy2 - dx2 * dy1;
+        if (!(std::abs(det) > 0x1p-20 * (std::abs(dx1 * dy2) + std::abs(dx2 * dy1)))) continue;
+        const double slopeX = (dd1 * dy2 - dd2 * dy1) / det, slopeY = (dx1 * dd2 - dx2 * dd1) / det;
+        out.planes[out.count++] = {slopeX, slopeY, q0.z - slopeX * x0 - slopeY * y0};
+    }
 }
 
 bool ScreenProjection::boxDepth(const ObjectProjection& object, const Aabb& local, DepthFootprint& out) const {
     glm::dvec2 lo, hi;
     double nearest = 0.0;
-    switch (boxNdc(object, local, lo, hi, nearest)) {
+    switch (boxNdc(object, local, lo, hi, nearest, &out.planes)) {
     case BoxNdc::Crossing: return false;
     case BoxNdc::Thin:  // as a box of boxes; the float matrix is toWorld rounded back, exactly
+        out.planes.count = 0;
         return volumeDepth(QueryVolume::fromTransformedBox(glm::mat4(object.toWorld), local), out);
     case BoxNdc::InFront: break;
     }
@@ -208,12 +249,14 @@ bool ScreenProjection::boxDepth(const ObjectProjection& object, const Aabb& loca
     return true;
 }
 
-bool ScreenProjection::boxCentres(const ObjectProjection& object, const Aabb& local, ScreenRect& centres, float& nearestDepth) const {
+bool ScreenProjection::boxCentres(const ObjectProjection& object, const Aabb& local, ScreenRect& centres, float& nearestDepth,
+                                  DepthPlanes* planes) const {
     glm::dvec2 lo, hi;
     double nearest = 0.0;
-    switch (boxNdc(object, local, lo, hi, nearest)) {
+    switch (boxNdc(object, local, lo, hi, nearest, planes)) {
     case BoxNdc::Crossing: return false;
     case BoxNdc::Thin: {
+        if (planes) planes->count = 0;
         DepthFootprint fp;
         if (!volumeDepth(QueryVolume::fromTransformedBox(glm::mat4(object.toWorld), local), fp)) return false;
         centres = fp.centres;
@@ -246,6 +289,7 @@ bool ScreenProjection::pointsDepth(const glm::dvec3* rel, std::uint32_t n, Depth
     out.rect = pixelRect(lo, hi);
     out.centres = centreRect(lo, hi);
     out.nearest = static_cast<float>(nearest);
+    out.planes.count = 0;
     return true;
 }
 

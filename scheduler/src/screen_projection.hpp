@@ -4,10 +4,13 @@
 // Used by every mode's first visibility test, the depth-pyramid test and cluster culling.
 #pragma once
 
+#include <array>
+
 #include <glm/glm.hpp>
 
 #include "dyncull/objects/aabb.hpp"
 #include "dyncull/objects/camera.hpp"
+#include "dyncull/scheduler/depth_pyramid.hpp"
 #include "dyncull/scheduler/occupancy_map.hpp"
 #include "dyncull/scheduler/query_backend.hpp"
 
@@ -23,6 +26,9 @@ struct DepthFootprint {
     /// it covers no pixel centre, and then it draws no fragment there.
     ScreenRect centres;
     float nearest = 1.0f;  ///< nearest window depth (reversed Z: the largest of its points')
+    /// Its nearest depth pixel by pixel, bounded by its front faces' planes: set by boxDepth
+    /// (none from volumeDepth); what DepthPyramid::occludedPerTexel reads.
+    DepthPlanes planes;
 };
 
 /// One object's matrix prepared for the footprints of many boxes in its object space (a
@@ -40,13 +46,18 @@ struct ObjectProjection {
     glm::dvec4 toDistance{0.0};
     /// |toWorld|'s linear columns: a box's half axes' summed reach per world axis.
     glm::dmat3 absLinear{0.0};
+    /// The eye in object space, which tells a box's front faces; not known for a singular
+    /// matrix, whose boxes then get no DepthFootprint::planes.
+    glm::dvec3 eyeLocal{0.0};
+    bool eyeKnown = false;
 };
 
 /// Projects world-space boxes and volumes into one frame's viewport (pixels, origin at the
 /// lower left, as the occupancy maps and the depth pyramid count them). Borrows the view.
 class ScreenProjection {
 public:
-    explicit ScreenProjection(const FrameView& view) : view_(view), distanceRow_(view.camera.distanceRowRelative()) {}
+    explicit ScreenProjection(const FrameView& view)
+        : view_(view), distanceRow_(view.camera.distanceRowRelative()), world_(objectProjection(glm::mat4(1.0f))) {}
 
     /// The pixels world box `box` can touch, its part behind the near plane clipped away;
     /// false if the box reaches the near plane (within the rounding a GPU's float clipping
@@ -57,6 +68,8 @@ public:
     /// its vertices' rounding first; false if it reaches the near plane (then it is simply
     /// visible).
     bool volumeDepth(const QueryVolume& volume, DepthFootprint& out) const;
+    /// The identity prepared for boxDepth: world-space boxes.
+    const ObjectProjection& worldProjection() const { return world_; }
     /// `matrix` (object to world) prepared for boxDepth.
     ObjectProjection objectProjection(const glm::mat4& matrix) const;
     /// volumeDepth(QueryVolume::fromTransformedBox(matrix, local), out) for the matrix that
@@ -68,7 +81,9 @@ public:
     bool boxDepth(const ObjectProjection& object, const Aabb& local, DepthFootprint& out) const;
     /// boxDepth's `centres` and `nearest` alone, all a depth-pyramid test reads (the
     /// clusters' test, by the tens of thousands a frame).
-    bool boxCentres(const ObjectProjection& object, const Aabb& local, ScreenRect& centres, float& nearestDepth) const;
+    /// With `planes`, also its front faces' planes (DepthFootprint::planes).
+    bool boxCentres(const ObjectProjection& object, const Aabb& local, ScreenRect& centres, float& nearestDepth,
+                    DepthPlanes* planes = nullptr) const;
     /// A guess, for choices that need no guarantee (cluster history's record of what
     /// showed): the pixels whose centres box `local` under `objectToClip` (object space to
     /// clip space, camera-relative: clipMatrixOf) covers and its nearest window depth, its 8
@@ -94,12 +109,19 @@ private:
     /// boxDepth's corners in normalised device coordinates: their bounds and nearest window
     /// depth (InFront), a box reaching the near plane (Crossing), or one too thin for the
     /// margins of its centre-and-axes form (Thin: left to volumeDepth).
-    BoxNdc boxNdc(const ObjectProjection& object, const Aabb& local, glm::dvec2& ndcLo, glm::dvec2& ndcHi, double& nearestDepth) const;
+    /// With `planes`, also the planes of the (grown) box's front faces (DepthFootprint::planes).
+    BoxNdc boxNdc(const ObjectProjection& object, const Aabb& local, glm::dvec2& ndcLo, glm::dvec2& ndcHi, double& nearestDepth,
+                  DepthPlanes* planes = nullptr) const;
+    /// boxNdc's planes: of the box with centre `centre` and half extents `half` (object
+    /// space, grown), from its corners' NDC x, y and window depth.
+    void frontFacePlanes(const ObjectProjection& object, const glm::dvec3& centre, const glm::dvec3& half,
+                         const std::array<glm::dvec3, 8>& corners, DepthPlanes& out) const;
     /// The footprint of the eye-relative points `rel[0, n)`, which already hold their margins.
     bool pointsDepth(const glm::dvec3* rel, std::uint32_t n, DepthFootprint& out) const;
 
     const FrameView& view_;
     glm::dvec4 distanceRow_;  // Camera::distanceRowRelative
+    ObjectProjection world_;  // worldProjection
 };
 
 }  // namespace dyncull

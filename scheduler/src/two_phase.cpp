@@ -224,7 +224,7 @@ void QueryScheduler::lateTraversal(Frame& f, bool testing, bool haveDepth, bool 
             ++f.stats.depthTests;
             // The pyramid exists only for a single-sample target, where a volume that covers
             // no pixel centre draws nothing.
-            const bool occluded = fp.centres.empty() || pyramid_.occluded(fp.centres, fp.nearest, params_.tuning.pyramidSpan);
+            const bool occluded = pyramidHides(f, fp);
             if (params_.tuning.splitDrawWaits) f.stats.pyramidTestMs += msSince(tTest);
             if (occluded) {
                 ++f.stats.queriesOccluded;
@@ -420,8 +420,7 @@ bool QueryScheduler::testOnFinalPyramid(Frame& f) {
     for (const NodeRef ref : refresh_) {
         DepthFootprint fp;
         ++f.stats.depthTests;
-        const bool hidden = testedFootprint(f, ref, fp) && !fp.rect.empty() &&
-                            (fp.centres.empty() || pyramid_.occluded(fp.centres, fp.nearest, params_.tuning.pyramidSpan));
+        const bool hidden = testedFootprint(f, ref, fp) && !fp.rect.empty() && pyramidHides(f, fp);
         if (hidden) culledTriangles_ += subtreeTriangles(f, ref);
         hiddenParts += hidden;
         history_.recordAnswer(history_.at(ref, f.objects), !hidden, f.index);
@@ -533,8 +532,19 @@ float QueryScheduler::testedAutoSaving(const Frame& f, NodeRef ref) const {
     return asClusters ? 1.0f : params_.tuning.autoVolumeSaving;
 }
 
+bool QueryScheduler::pyramidHides(Frame& f, const DepthFootprint& fp) const {
+    // The pyramid exists only for a single-sample target, where a volume that covers no
+    // pixel centre draws nothing.
+    if (fp.centres.empty() || pyramid_.occluded(fp.centres, fp.nearest, params_.tuning.pyramidSpan)) return true;
+    if (params_.tuning.texelTestTexels == 0) return false;
+    const bool hidden = pyramid_.occludedPerTexel(fp.centres, fp.nearest, fp.planes, params_.tuning.texelTestTexels);
+    f.stats.texelOccluded += hidden;
+    return hidden;
+}
+
 bool QueryScheduler::testedFootprint(const Frame& f, NodeRef ref, DepthFootprint& out) const {
-    if (ref.isSceneNode() || !params_.features.useTightVolumes) return f.screen.volumeDepth(testedVolume(f, ref), out);
+    if (ref.isSceneNode()) return f.screen.boxDepth(f.screen.worldProjection(), f.tree.worldBox(ref), out);
+    if (!params_.features.useTightVolumes) return f.screen.volumeDepth(testedVolume(f, ref), out);
     const SceneObjects& objs = f.objects;
     if (objectNodeVolumeKind(objs, ref, params_.tuning.volume, testedAutoSaving(f, ref)) != VolumeKind::Aabb)
         return f.screen.volumeDepth(testedVolume(f, ref), out);

@@ -59,6 +59,9 @@ TEST(BenchModes, AblationsOfFullAndTheirVolumes) {
     EXPECT_FALSE(modeFromName("full-rasterrefresh")->scheduler.features.useRefreshPyramid);
     EXPECT_TRUE(modeFromName("full")->scheduler.features.useLearnedClusters);
     EXPECT_FALSE(modeFromName("full-ownrecord")->scheduler.features.useLearnedClusters);
+    EXPECT_GT(modeFromName("full")->scheduler.tuning.texelTestTexels, 0);
+    EXPECT_EQ(modeFromName("full-notexel")->scheduler.tuning.texelTestTexels, 0);
+    EXPECT_EQ(modeFromName("full-notexel")->scheduler.tuning.clusterTexelTests, 0);
     const ModeSpec k = modeFromName("full+kdop26").take();
     EXPECT_EQ(k.scheduler.mode, CullMode::TwoPhase);
     EXPECT_EQ(k.scheduler.tuning.volume, VolumeChoice::Kdop26);

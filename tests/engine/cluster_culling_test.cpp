@@ -96,9 +96,14 @@ protected:
     /// radians round the ring; `each(x, y)` takes both frames' stats (on, off).
     template <class Each>
     void onOffAgainstVfc(bool SchedulerFeatures::*feature, int frames, float step, Each each) {
+        ASSERT_TRUE(paramsOf(CullMode::TwoPhase, true).features.*feature) << "the feature is on by default";
+        onOffAgainstVfc([&](SchedulerParams& p) { p.features.*feature = false; }, frames, step, each);
+    }
+    /// The same with what `turnOff(params)` turns off.
+    template <class TurnOff, class Each>
+    void onOffAgainstVfc(TurnOff turnOff, int frames, float step, Each each) {
         SchedulerParams on = paramsOf(CullMode::TwoPhase, true), off = on;
-        ASSERT_TRUE(on.features.*feature) << "the feature is on by default";
-        off.features.*feature = false;
+        turnOff(off);
         QueryScheduler a(on), b(off), vfc(paramsOf(CullMode::Vfc, true));
         for (int f = 0; f < frames; ++f) {
             SCOPED_TRACE("frame " + std::to_string(f));
@@ -256,6 +261,29 @@ TEST_F(ClusterHistory, TheRecordTakesWhatTheFramesTestsLearned) {
                 static_cast<unsigned long long>(earlyOwn));
     EXPECT_GT(learned, 0u);
     EXPECT_LE(double(earlyLearning), 1.02 * double(earlyOwn));
+}
+
+TEST_F(ClusterCulling, PerTexelTestsHideMoreAndDrawVfcsImage) {
+    // A volume or cluster the pyramid test at its span lets through is tested again texel
+    // by texel against its front faces' planes (SchedulerTuning::texelTestTexels,
+    // clusterTexelTests): it may hide more, never a pixel of vfc's image.
+    build({2000, 8, 3.2f, 1.0f, {2.2f, 1.6f, 2.2f}});
+    if (HasFatalFailure()) return;
+    const SchedulerParams defaults = paramsOf(CullMode::TwoPhase, true);
+    ASSERT_GT(defaults.tuning.texelTestTexels, 0);
+    ASSERT_GT(defaults.tuning.clusterTexelTests, 0);
+    std::uint64_t hiddenParts = 0, drawnOn = 0, drawnOff = 0;
+    onOffAgainstVfc([](SchedulerParams& p) { p.tuning.texelTestTexels = p.tuning.clusterTexelTests = 0; }, 24, 0.12f,
+                    [&](const FrameStats& x, const FrameStats& y) {
+                        EXPECT_EQ(y.texelOccluded, 0u);
+                        hiddenParts += x.texelOccluded;
+                        drawnOn += x.trianglesDrawn;
+                        drawnOff += y.trianglesDrawn;
+                    });
+    std::printf("per-texel tests: %llu parts hidden; %llu triangles drawn against %llu without\n",
+                static_cast<unsigned long long>(hiddenParts), static_cast<unsigned long long>(drawnOn),
+                static_cast<unsigned long long>(drawnOff));
+    EXPECT_LT(drawnOn, drawnOff);
 }
 
 TEST_F(ClusterHistory, TheRecordIsPricedFromCountsSoTwinsDecideAlike) {

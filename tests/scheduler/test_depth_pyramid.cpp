@@ -94,6 +94,72 @@ TEST(DepthPyramid, NeverNearerThanTheExactFarthestAndExactForSmallRects) {
 // occluded reads a coarse level first and stops at the first texel in front: its answer
 // is still that of every texel at the finest level where the rectangle spans at most
 // `span` texels, read in full (the reference below, from the public texels).
+// The per-texel test against its pixel-by-pixel oracle, with random planes (up to three,
+// steep and shallow, some pointing the bound nearer than the buffer, some behind it):
+// never "occluded" where the oracle shows a pixel, whatever the texel budget, and, with a
+// budget large enough to reach every pixel, exactly the oracle's answer.
+TEST(DepthPyramid, PerTexelTestNeverHidesWhatThePixelOracleShows) {
+    std::mt19937 rng(29);
+    std::uniform_real_distribution<double> u(0.0, 1.0), slope(-0.01, 0.01);
+    const int sizes[][2] = {{1, 1}, {7, 3}, {65, 33}, {640, 360}};
+    std::uint64_t hidden = 0, shown = 0, gaveUp = 0;
+    for (const auto& s : sizes) {
+        const Buffer b = makeBuffer(s[0], s[1], 8, rng);
+        DepthPyramid p;
+        p.build(b.depth, b.width, b.height);
+        for (int i = 0; i < 1500; ++i) {
+            const ScreenRect r = randomRect(b.width, b.height, rng);
+            DepthPlanes planes;
+            planes.count = static_cast<std::uint32_t>(std::uniform_int_distribution<int>(0, 3)(rng));
+            const double base = u(rng);
+            for (std::uint32_t k = 0; k < planes.count; ++k) {
+                const double scale = (i % 3 == 0) ? 10.0 : 1.0;  // some planes steep
+                planes.planes[k] = {slope(rng) * scale, slope(rng) * scale, base + 0.3 * (u(rng) - 0.5)};
+            }
+            const float nearest = static_cast<float>(u(rng));
+            const bool truth = occludedPerPixelBruteForce(b.depth, b.width, b.height, r, nearest, planes);
+            for (const int budget : {1, 16, 256}) {
+                const bool fast = p.occludedPerTexel(r, nearest, planes, budget);
+                if (fast) {
+                    ASSERT_TRUE(truth) << "budget " << budget << ", case " << i << " of " << s[0] << "x" << s[1];
+                }
+                gaveUp += truth && !fast;
+            }
+            ASSERT_EQ(p.occludedPerTexel(r, nearest, planes, 1 << 20), truth) << "case " << i << " of " << s[0] << "x" << s[1];
+            (truth ? hidden : shown) += 1;
+        }
+    }
+    // Both answers must have been exercised.
+    EXPECT_GT(hidden, 500u);
+    EXPECT_GT(shown, 500u);
+    std::printf("per-texel test: %llu hidden, %llu shown; a small budget answered visible for a hidden one %llu times\n",
+                static_cast<unsigned long long>(hidden), static_cast<unsigned long long>(shown), static_cast<unsigned long long>(gaveUp));
+}
+
+// A wall seen at a slant, just behind another parallel to it: its nearest depth over the
+// whole rectangle is in front of most of the buffer, so the pyramid test shows it; bounded
+// by its plane, it is behind at every pixel.
+TEST(DepthPyramid, APlaneHidesASlantedSurfaceTheNearestDepthCannot) {
+    const int w = 64, h = 16;
+    std::vector<float> depth(static_cast<std::size_t>(w * h));
+    DepthPlanes planes;
+    planes.count = 1;
+    planes.planes[0] = {0.01, 0.0, 0.1};  // 0.1 at the left edge, 0.74 at the right
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) depth[static_cast<std::size_t>(y * w + x)] = float(0.1 + 0.01 * (x + 1.5) + 0.02);
+    DepthPyramid p;
+    p.build(depth, w, h);
+    const ScreenRect all{0, 0, w, h};
+    const float nearest = 0.75f;
+    EXPECT_FALSE(p.occluded(all, nearest, 64));
+    EXPECT_TRUE(p.occludedPerTexel(all, nearest, planes, 1 << 20));
+    EXPECT_TRUE(occludedPerPixelBruteForce(depth, w, h, all, nearest, planes));
+    // One pixel in front of the plane makes it visible.
+    depth[static_cast<std::size_t>(5 * w + 40)] = 0.0f;
+    p.build(depth, w, h);
+    EXPECT_FALSE(p.occludedPerTexel(all, nearest, planes, 1 << 20));
+}
+
 TEST(DepthPyramid, ShortCutAnswersAsReadingEveryTexelOfTheSpanLevel) {
     std::mt19937 rng(13);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);

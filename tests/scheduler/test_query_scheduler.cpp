@@ -398,6 +398,14 @@ TEST(QueryScheduler, ParamsAreValidated) {
         p.tuning.recordPyramidSpan = span;
         EXPECT_FALSE(validateSchedulerParams(p).ok()) << span;
     }
+    for (const int texels : {-1, 65537}) {
+        p = {};
+        p.tuning.texelTestTexels = texels;
+        EXPECT_FALSE(validateSchedulerParams(p).ok()) << texels;
+        p = {};
+        p.tuning.clusterTexelTests = texels;
+        EXPECT_FALSE(validateSchedulerParams(p).ok()) << texels;
+    }
     for (const std::uint32_t rounds : {0u, 17u}) {
         p = {};
         p.tuning.candidateRounds = rounds;
@@ -408,6 +416,8 @@ TEST(QueryScheduler, ParamsAreValidated) {
     p.tuning.pyramidSpan = 64;
     p.tuning.clusterPyramidSpan = 2;
     p.tuning.recordPyramidSpan = 64;
+    p.tuning.texelTestTexels = 0;
+    p.tuning.clusterTexelTests = 65536;
     EXPECT_TRUE(validateSchedulerParams(p).ok());
     EXPECT_FALSE(parseCullMode("fast").ok());
     EXPECT_EQ(parseCullMode("full").value(), CullMode::TwoPhase);

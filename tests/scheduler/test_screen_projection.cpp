@@ -139,6 +139,52 @@ TEST(ScreenProjection, RoughBoxDepthIsTheExactFootprintWithinRounding) {
     EXPECT_GT(compared, 200);
 }
 
+// boxDepth's front-face planes bound the box's depth pixel by pixel: every point of the box
+// (corners, points on its faces, inside) projects no nearer than each plane's depth at its
+// own window position. Perspective only; an orthographic view gets no planes.
+TEST(ScreenProjection, FrontFacePlanesAreNeverBehindTheBox) {
+    std::mt19937 rng(23);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    int withPlanes = 0, points = 0;
+    for (const float scale : {1.0f, 1e-3f, 1e4f}) {
+        for (int i = 0; i < 400; ++i) {
+            const Case c = randomCase(rng, false, scale);
+            const FrameView view = FrameView::of(c.camera, 640, 360);
+            const ScreenProjection screen(view);
+            DepthFootprint fp;
+            if (!screen.boxDepth(screen.objectProjection(c.matrix), c.box, fp)) continue;
+            ASSERT_LE(fp.planes.count, 3u);
+            withPlanes += fp.planes.count > 0;
+            for (int k = 0; k < 64; ++k) {
+                // Corners first, then points on the faces, then inside.
+                glm::dvec3 t(u(rng), u(rng), u(rng));
+                if (k < 8) t = glm::dvec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
+                else if (k < 32) t[k % 3] = (k & 8) ? 1.0 : 0.0;
+                const glm::dvec3 local = glm::dvec3(c.box.min) + t * (glm::dvec3(c.box.max) - glm::dvec3(c.box.min));
+                const glm::dvec3 rel = glm::dvec3(glm::dmat4(c.matrix) * glm::dvec4(local, 1.0)) - glm::dvec3(c.camera.position);
+                const glm::dvec4 clip = view.viewProjRelative * glm::dvec4(rel, 1.0);
+                const glm::dvec2 px = (glm::dvec2(clip) / clip.w + 1.0) * 0.5 * glm::dvec2(view.width, view.height);
+                const double depth = clip.z / clip.w;
+                for (std::uint32_t j = 0; j < fp.planes.count; ++j) {
+                    const auto& [a, b, d0] = fp.planes.planes[j];
+                    EXPECT_GE(a * px.x + b * px.y + d0, depth - 1e-9 * std::abs(depth)) << "case " << i << ", plane " << j;
+                }
+                ++points;
+            }
+        }
+    }
+    EXPECT_GT(withPlanes, 300) << "too few boxes with planes to check";
+    EXPECT_GT(points, 20000);
+    // Orthographic: none.
+    const Case c = randomCase(rng, true, 1.0f);
+    const FrameView view = FrameView::of(c.camera, 640, 360);
+    const ScreenProjection screen(view);
+    DepthFootprint fp;
+    if (screen.boxDepth(screen.objectProjection(c.matrix), c.box, fp)) {
+        EXPECT_EQ(fp.planes.count, 0u);
+    }
+}
+
 TEST(ScreenProjection, BoxAroundTheEyeIsVisible) {
     Camera camera;
     camera.position = {0.3f, -0.2f, 0.1f};

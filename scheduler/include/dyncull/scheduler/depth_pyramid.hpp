@@ -11,6 +11,7 @@
 // Bevy got wrong, see ../shared/notes/batched-occlusion-tests.md).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -18,6 +19,22 @@
 #include "dyncull/scheduler/occupancy_map.hpp"
 
 namespace dyncull {
+
+/// Planes that bound a convex volume's nearest window depth pixel by pixel, where one
+/// nearest depth for its whole footprint is loose (a long wall seen at a slant, a box whose
+/// near corner pokes out beside an occluder). Each is the window depth of one of the
+/// volume's front faces' planes, an affine function of window coordinates in pixels
+/// (origin at the lower left, pixel (x, y)'s centre at (x + 0.5, y + 0.5)):
+/// depth = a x + b y + c. A ray enters a convex volume through its front faces, and the
+/// entry is the last of those planes it crosses: at every point whose ray meets the volume,
+/// its nearest depth is at most each plane's depth there (reversed Z, nearer is greater).
+/// Any subset of the front faces' planes is such a bound, so a face too close to edge-on
+/// to be trusted is left out. Filled by ScreenProjection::boxDepth.
+struct DepthPlanes {
+    static constexpr std::size_t kMax = 3;  ///< a box shows at most three faces
+    std::array<std::array<double, 3>, kMax> planes{};  ///< {a, b, c}; [0, count) used
+    std::uint32_t count = 0;
+};
 
 /// Depths are window depths in dyncull's reversed-Z convention (objects/camera.hpp): 1 at
 /// the near plane, 0 at the far plane (and the cleared value), nearer is greater; the
@@ -61,6 +78,21 @@ public:
     /// hidden more often.
     bool occluded(const ScreenRect& rect, float nearestDepth, int maxSpan) const;
 
+    /// The same test as occluded(rect, nearestDepth, 2) first, then, where that cannot
+    /// decide, texel by texel down the pyramid with the surface's depth bounded over each
+    /// texel by `planes` (and by nearestDepth): a texel whose pixels the surface lies
+    /// behind is settled, one it may not be is split into its four finer texels, and a
+    /// pixel it may not be behind makes it visible. `rect` holds the pixels whose centres
+    /// the surface can cover (DepthFootprint::centres); each bound is taken over their
+    /// centres grown by kSnapPixels, where a rasteriser's snapping may move a surface
+    /// point. Gives up, answering visible, after `maxTexels` texels (>= 1). With no planes
+    /// it reads down to single pixels too, against nearestDepth alone.
+    bool occludedPerTexel(const ScreenRect& rect, float nearestDepth, const DepthPlanes& planes, int maxTexels) const;
+
+    /// How far a rasteriser may move a vertex when it snaps it to its sub-pixel grid, in
+    /// pixels: GL's at least 4 sub-pixel bits move it by at most 1/32; twice that.
+    static constexpr double kSnapPixels = 1.0 / 16.0;
+
     /// Relative margin on depths: the GPU's depth of a surface point and the CPU's exact
     /// depth of the volume around it differ by float rounding (a few ulp, 2^-23 each); the
     /// margin is 2^-16 of the depth, far above that and far below any real separation.
@@ -95,6 +127,13 @@ private:
     std::vector<Level> levels_;
     int width_ = 0, height_ = 0;
 };
+
+/// The oracle of occludedPerTexel, pixel by pixel: true only if at every pixel of `rect`
+/// (clamped to the screen) the surface's bound (nearestDepth, and each plane's depth over
+/// the pixel's centre grown by DepthPyramid::kSnapPixels) lies behind the pixel's depth by
+/// more than DepthPyramid::kDepthSlack.
+bool occludedPerPixelBruteForce(std::span<const float> depth, int width, int height, const ScreenRect& rect, float nearestDepth,
+                                const DepthPlanes& planes);
 
 /// The oracle: farthest depth over exactly the pixels of `rect` (clamped to the screen),
 /// by looking at each one; 1 for an empty or off-screen rectangle, as farthestIn.

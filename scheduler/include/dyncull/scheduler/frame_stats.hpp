@@ -42,6 +42,9 @@ struct FrameStats {
     /// the frame's own cluster tests (SchedulerFeatures::useLearnedClusters) rather than
     /// projecting them again.
     std::uint32_t clustersLearned = 0;
+    /// Two-phase: volumes hidden texel by texel (SchedulerTuning::texelTestTexels) that the
+    /// pyramid test at its span let through; in depthTests already.
+    std::uint32_t texelOccluded = 0;
     double clusterMs = 0.0;             ///< CPU in the cluster tests, and in the final-depth tests of cluster history
     std::uint64_t queryTriangles = 0;   ///< triangles of the query volumes drawn (12 per box)
     std::uint32_t queriesOccluded = 0;  ///< answered "occluded"

@@ -293,6 +293,14 @@ struct SchedulerTuning {
     /// on the power plant's record; the bunny path's clusters are small enough that both
     /// decide alike (docs/BENCHMARKS.md, "record span").
     int recordPyramidSpan = 16;
+    /// TwoPhase: a volume the late pass's pyramid test (pyramidSpan) cannot reject is
+    /// tested again texel by texel down to single pixels, its depth over each texel bounded
+    /// by its front faces' planes (DepthPyramid::occludedPerTexel), reading at most this
+    /// many texels before it gives up; the same for the parts tested against the final
+    /// depth. 0: off. In [0, 65536].
+    int texelTestTexels = 256;
+    /// The same for a cluster's box (cluster_culling.cpp), in [0, 65536].
+    int clusterTexelTests = 256;
     /// TwoPhase: the late pass's candidates are tested in this many rounds, front to back
     /// (at least 1, at most 16): each round is tested against the depth of the rounds before
     /// it, whose visible parts are drawn first, at the price of one more wait per round. 2
@@ -575,6 +583,9 @@ private:
     /// the refresh where the record reads the final depth anyway (useRefreshPyramid).
     /// False if the depth could not be read (nothing recorded).
     bool testOnFinalPyramid(Frame& f);
+    /// The late pass's pyramid test of a volume's footprint: at pyramidSpan, then texel by
+    /// texel (SchedulerTuning::texelTestTexels). True if hidden behind the pyramid.
+    bool pyramidHides(Frame& f, const DepthFootprint& fp) const;
     /// True if a triangle test of `ref` is expected to save more drawing than it costs.
     bool worthTriangleTest(const Frame& f, NodeRef ref);
     /// Tests triangleTests_ (PartSink::testParts), draws the visible ones, records the answers.
