@@ -30,11 +30,14 @@ ClusterTest clusterTest(const QueryScheduler::Frame& f, const DepthPyramid* pyra
                         const ObjectProjection& object, const LeafCluster& c, bool frustum, ScreenRect& centres, float& nearest) {
     if (frustum && f.frustum().outside(transformAabb(matrix, c.box))) return ClusterTest::Hidden;
     if (!pyramid) return ClusterTest::Untested;
-    DepthPlanes planes;
-    if (!f.screen.boxCentres(object, c.box, centres, nearest, texels > 0 ? &planes : nullptr)) return ClusterTest::Crossing;
+    BoxCorners corners;
+    if (!f.screen.boxCentres(object, c.box, centres, nearest, texels > 0 ? &corners : nullptr)) return ClusterTest::Crossing;
     // A pyramid exists only for a single-sample target: a cluster covering no pixel centre draws nothing.
     if (centres.empty() || pyramid->occluded(centres, nearest, span)) return ClusterTest::Hidden;
-    return texels > 0 && pyramid->occludedPerTexel(centres, nearest, planes, texels) ? ClusterTest::Hidden : ClusterTest::Passed;
+    if (texels == 0) return ClusterTest::Passed;
+    DepthPlanes planes;
+    f.screen.frontFacePlanes(object, corners, planes);
+    return pyramid->occludedPerTexel(centres, nearest, planes, texels) ? ClusterTest::Hidden : ClusterTest::Passed;
 }
 }  // namespace
 

@@ -156,7 +156,7 @@ ObjectProjection ScreenProjection::objectProjection(const glm::mat4& matrix) con
 }
 
 ScreenProjection::BoxNdc ScreenProjection::boxNdc(const ObjectProjection& object, const Aabb& local, glm::dvec2& ndcLo, glm::dvec2& ndcHi,
-                                                  double& nearestDepth, DepthPlanes* planes) const {
+                                                  double& nearestDepth, BoxCorners* corners) const {
     // QueryVolume::enlargedForRounding for a box: its vertices' magnitude sets the margin,
     // and each face is pushed out by it through a scale about the centre by k.
     const glm::dvec3 lo(local.min), hi(local.max);
@@ -189,7 +189,11 @@ ScreenProjection::BoxNdc ScreenProjection::boxNdc(const ObjectProjection& object
     ndcLo = glm::dvec2(1e300);
     ndcHi = glm::dvec2(-1e300);
     nearestDepth = 0.0;
-    std::array<glm::dvec3, 8> window;  // x, y in NDC, then window depth
+    if (corners) {
+        corners->centre = centre;
+        corners->half = k * half;
+        corners->valid = true;
+    }
     for (int i = 0; i < 8; ++i) {
         const glm::dvec4 clip = c + ((i & 1) ? p0 : -p0) + ((i & 2) ? p1 : -p1) + ((i & 4) ? p2 : -p2);
         const double inv = 1.0 / clip.w;
@@ -197,20 +201,21 @@ ScreenProjection::BoxNdc ScreenProjection::boxNdc(const ObjectProjection& object
         ndcLo = glm::min(ndcLo, ndc);
         ndcHi = glm::max(ndcHi, ndc);
         nearestDepth = std::max(nearestDepth, clip.z * inv);
-        window[static_cast<std::size_t>(i)] = {ndc, clip.z * inv};
+        if (corners) corners->window[static_cast<std::size_t>(i)] = {ndc, clip.z * inv};
     }
-    if (planes) frontFacePlanes(object, centre, k * half, window, *planes);
     return BoxNdc::InFront;
 }
 
-void ScreenProjection::frontFacePlanes(const ObjectProjection& object, const glm::dvec3& centre, const glm::dvec3& half,
-                                       const std::array<glm::dvec3, 8>& corners, DepthPlanes& out) const {
+void ScreenProjection::frontFacePlanes(const ObjectProjection& object, const BoxCorners& box, DepthPlanes& out) const {
     // A face is front-facing when the eye lies outside its plane, judged in object space
     // with a margin of 2^-20 of the magnitudes (far above the rounding of the inverse): a
     // back face taken for a front one would bound the depth by the box's far side, so
     // a face too close to call is left out.
     out.count = 0;
-    if (!object.eyeKnown) return;
+    if (!object.eyeKnown || !box.valid) return;
+    const glm::dvec3& centre = box.centre;
+    const glm::dvec3& half = box.half;
+    const std::array<glm::dvec3, 8>& corners = box.window;
     const double fx = 0.5 * view_.width, fy = 0.5 * view_.height;
     for (int a = 0; a < 3; ++a) {
         const double outside = std::abs(object.eyeLocal[a] - centre[a]) - half[a];
@@ -236,13 +241,14 @@ void ScreenProjection::frontFacePlanes(const ObjectProjection& object, const glm
 bool ScreenProjection::boxDepth(const ObjectProjection& object, const Aabb& local, DepthFootprint& out) const {
     glm::dvec2 lo, hi;
     double nearest = 0.0;
-    switch (boxNdc(object, local, lo, hi, nearest, &out.planes)) {
+    BoxCorners corners;
+    switch (boxNdc(object, local, lo, hi, nearest, &corners)) {
     case BoxNdc::Crossing: return false;
     case BoxNdc::Thin:  // as a box of boxes; the float matrix is toWorld rounded back, exactly
-        out.planes.count = 0;
         return volumeDepth(QueryVolume::fromTransformedBox(glm::mat4(object.toWorld), local), out);
     case BoxNdc::InFront: break;
     }
+    frontFacePlanes(object, corners, out.planes);
     out.rect = pixelRect(lo, hi);
     out.centres = centreRect(lo, hi);
     out.nearest = static_cast<float>(nearest);
@@ -250,13 +256,13 @@ bool ScreenProjection::boxDepth(const ObjectProjection& object, const Aabb& loca
 }
 
 bool ScreenProjection::boxCentres(const ObjectProjection& object, const Aabb& local, ScreenRect& centres, float& nearestDepth,
-                                  DepthPlanes* planes) const {
+                                  BoxCorners* corners) const {
     glm::dvec2 lo, hi;
     double nearest = 0.0;
-    switch (boxNdc(object, local, lo, hi, nearest, planes)) {
+    if (corners) corners->valid = false;
+    switch (boxNdc(object, local, lo, hi, nearest, corners)) {
     case BoxNdc::Crossing: return false;
     case BoxNdc::Thin: {
-        if (planes) planes->count = 0;
         DepthFootprint fp;
         if (!volumeDepth(QueryVolume::fromTransformedBox(glm::mat4(object.toWorld), local), fp)) return false;
         centres = fp.centres;

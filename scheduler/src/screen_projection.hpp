@@ -52,6 +52,15 @@ struct ObjectProjection {
     bool eyeKnown = false;
 };
 
+/// A projected box's corners, kept by ScreenProjection::boxCentres for the front-face planes
+/// it may be asked for afterwards (ScreenProjection::frontFacePlanes): most boxes a pyramid
+/// test hides at once never need them.
+struct BoxCorners {
+    glm::dvec3 centre{0.0}, half{0.0};  ///< the box grown by its rounding, object space
+    std::array<glm::dvec3, 8> window;   ///< corner i: NDC x, y and window depth
+    bool valid = false;                 ///< false where the box was too thin for them
+};
+
 /// Projects world-space boxes and volumes into one frame's viewport (pixels, origin at the
 /// lower left, as the occupancy maps and the depth pyramid count them). Borrows the view.
 class ScreenProjection {
@@ -81,9 +90,12 @@ public:
     bool boxDepth(const ObjectProjection& object, const Aabb& local, DepthFootprint& out) const;
     /// boxDepth's `centres` and `nearest` alone, all a depth-pyramid test reads (the
     /// clusters' test, by the tens of thousands a frame).
-    /// With `planes`, also its front faces' planes (DepthFootprint::planes).
+    /// With `corners`, also what its front faces' planes are computed from (frontFacePlanes).
     bool boxCentres(const ObjectProjection& object, const Aabb& local, ScreenRect& centres, float& nearestDepth,
-                    DepthPlanes* planes = nullptr) const;
+                    BoxCorners* corners = nullptr) const;
+    /// The planes of the front faces of a box that boxCentres kept `corners` of, projected
+    /// with `object` (DepthFootprint::planes); none if the corners are not valid.
+    void frontFacePlanes(const ObjectProjection& object, const BoxCorners& corners, DepthPlanes& out) const;
     /// A guess, for choices that need no guarantee (cluster history's record of what
     /// showed): the pixels whose centres box `local` under `objectToClip` (object space to
     /// clip space, camera-relative: clipMatrixOf) covers and its nearest window depth, its 8
@@ -109,13 +121,10 @@ private:
     /// boxDepth's corners in normalised device coordinates: their bounds and nearest window
     /// depth (InFront), a box reaching the near plane (Crossing), or one too thin for the
     /// margins of its centre-and-axes form (Thin: left to volumeDepth).
-    /// With `planes`, also the planes of the (grown) box's front faces (DepthFootprint::planes).
+    /// With `corners`, also the (grown) box and its corners' window coordinates, for its
+    /// front faces' planes (frontFacePlanes), where it is in front.
     BoxNdc boxNdc(const ObjectProjection& object, const Aabb& local, glm::dvec2& ndcLo, glm::dvec2& ndcHi, double& nearestDepth,
-                  DepthPlanes* planes = nullptr) const;
-    /// boxNdc's planes: of the box with centre `centre` and half extents `half` (object
-    /// space, grown), from its corners' NDC x, y and window depth.
-    void frontFacePlanes(const ObjectProjection& object, const glm::dvec3& centre, const glm::dvec3& half,
-                         const std::array<glm::dvec3, 8>& corners, DepthPlanes& out) const;
+                  BoxCorners* corners = nullptr) const;
     /// The footprint of the eye-relative points `rel[0, n)`, which already hold their margins.
     bool pointsDepth(const glm::dvec3* rel, std::uint32_t n, DepthFootprint& out) const;
 
