@@ -148,8 +148,8 @@ void QueryScheduler::selectClusters(const Frame& f, const ClusterJob& job, Clust
             LearnedCluster& learned = job.keepLearned ? out.learned[i] : scratch;
             ClusterTest test = job.cones && job.eye.backFacing(c) ? ClusterTest::Hidden : ClusterTest::Untested;
             if (test == ClusterTest::Untested && (job.frustum || pyramid))
-                test = clusterTest(f, pyramid, params_.tuning.clusterPyramidSpan, params_.tuning.clusterTexelTests, job.matrix, job.object, c, job.frustum,
-                                   learned.centres, learned.nearest);
+                test = clusterTest(f, pyramid, params_.tuning.clusterPyramidSpan, params_.tuning.clusterTexelTests, job.matrix,
+                                   job.object, c, job.frustum, learned.centres, learned.nearest);
             culled = test == ClusterTest::Hidden;
             learned.fate = culled ? LearnedCluster::Fate::Hidden
                            : test == ClusterTest::Crossing ? LearnedCluster::Fate::Crossing

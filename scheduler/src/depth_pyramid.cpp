@@ -165,7 +165,8 @@ bool DepthPyramid::occludedPerTexel(const ScreenRect& rect, float nearestDepth, 
         const int px0 = std::max(x0, t.x << t.level), px1 = std::min(x1, ((t.x + 1) << t.level) - 1);
         const int py0 = std::max(y0, t.y << t.level), py1 = std::min(y1, ((t.y + 1) << t.level) - 1);
         const Level& l = levels_[static_cast<std::size_t>(t.level)];
-        const float farthest = levelData(static_cast<std::size_t>(t.level))[static_cast<std::size_t>(t.y) * static_cast<std::size_t>(l.width) + static_cast<std::size_t>(t.x)];
+        const float farthest =
+            levelData(static_cast<std::size_t>(t.level))[static_cast<std::size_t>(t.y) * static_cast<std::size_t>(l.width) + static_cast<std::size_t>(t.x)];
         if (behind(boundOver(planes, nearestDepth, px0, py0, px1, py1), farthest)) continue;
         if (t.level == 0 || ++visited >= maxTexels) return false;
         const int k = t.level - 1;

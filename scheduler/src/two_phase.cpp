@@ -3,8 +3,9 @@
 //  1. early pass: the parts visible last frame are drawn, frustum-culled;
 //  2. their depth is read back into a farthest-depth pyramid (DepthPyramid);
 //  3. late pass: the tree is traversed front to back, every node tested against the
-//     pyramid (a rectangle and a depth, a few nanoseconds); an occluded node's subtree is
-//     skipped;
+//     pyramid (a rectangle and a depth, a few nanoseconds; where that cannot decide, texel
+//     by texel, the volume's depth bounded by its front faces' planes); an occluded node's
+//     subtree is skipped;
 //  4. the parts the pyramid let through are tested exactly, per pixel, in batched raster
 //     tests (NVIDIA's gl_occlusion_culling "temporal current frame" scheme), in rounds
 //     front to back, each against the depth drawn before it, and the visible ones drawn
@@ -222,8 +223,6 @@ void QueryScheduler::lateTraversal(Frame& f, bool testing, bool haveDepth, bool 
             continue;
         } else if (haveDepth) {
             ++f.stats.depthTests;
-            // The pyramid exists only for a single-sample target, where a volume that covers
-            // no pixel centre draws nothing.
             const bool occluded = pyramidHides(f, fp);
             if (params_.tuning.splitDrawWaits) f.stats.pyramidTestMs += msSince(tTest);
             if (occluded) {
