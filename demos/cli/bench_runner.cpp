@@ -6,7 +6,9 @@
 #include <charconv>
 #include <cstdio>
 #include <filesystem>
+#include <iterator>
 #include <string_view>
+#include <utility>
 
 #include "dyncull/measure/budget_oracle.hpp"
 #include "dyncull/measure/png_writer.hpp"
@@ -316,6 +318,15 @@ std::string sweepParamsHelp() {
            "TestCosts::pyramidNs); record-worker (full; clusters from which cluster history's frame-end record shares its tests with a second thread, SchedulerTuning::recordWorkerClusters); submit-tris (full; triangles drawn between two glFlush calls, EngineOptions::submitTriangles, 0 for none)";
 }
 
+namespace {
+// full's sweep parameters that count texels (int tuning fields): the swept value is clamped
+// into an int here and checked by validateSchedulerParams.
+constexpr std::pair<const char*, int SchedulerTuning::*> kTwoPhaseTexelParams[] = {
+    {"pyramid-span", &SchedulerTuning::pyramidSpan},          {"cluster-span", &SchedulerTuning::clusterPyramidSpan},
+    {"record-span", &SchedulerTuning::recordPyramidSpan},     {"texel-tests", &SchedulerTuning::texelTestTexels},
+    {"cluster-texel-tests", &SchedulerTuning::clusterTexelTests}};
+}  // namespace
+
 Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec) {
     const std::size_t eq = spec.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == spec.size())
@@ -348,24 +359,14 @@ Expected<std::vector<ModeSpec>> sweepModes(const std::string& spec) {
             m.scheduler.tuning.maxQueriesInFlight = v;
         } else if (param == "tile-size") {
             m.scheduler.tuning.occupancyTileSize = static_cast<int>(std::min<std::uint32_t>(v, 1u << 20));
-        } else if (param == "pyramid-span") {
+        } else if (const auto texels = std::find_if(std::begin(kTwoPhaseTexelParams), std::end(kTwoPhaseTexelParams),
+                                                    [&](const auto& t) { return param == t.first; });
+                   texels != std::end(kTwoPhaseTexelParams)) {
             m.scheduler.mode = CullMode::TwoPhase;
-            m.scheduler.tuning.pyramidSpan = static_cast<int>(std::min<std::uint32_t>(v, 1u << 20));
-        } else if (param == "texel-tests") {
-            m.scheduler.mode = CullMode::TwoPhase;
-            m.scheduler.tuning.texelTestTexels = static_cast<int>(std::min<std::uint32_t>(v, 1u << 20));
-        } else if (param == "cluster-texel-tests") {
-            m.scheduler.mode = CullMode::TwoPhase;
-            m.scheduler.tuning.clusterTexelTests = static_cast<int>(std::min<std::uint32_t>(v, 1u << 20));
+            m.scheduler.tuning.*texels->second = static_cast<int>(std::min<std::uint32_t>(v, 1u << 20));
         } else if (param == "candidate-rounds") {
             m.scheduler.mode = CullMode::TwoPhase;
             m.scheduler.tuning.candidateRounds = v;
-        } else if (param == "cluster-span") {
-            m.scheduler.mode = CullMode::TwoPhase;
-            m.scheduler.tuning.clusterPyramidSpan = static_cast<int>(std::min<std::uint32_t>(v, 1u << 20));
-        } else if (param == "record-span") {
-            m.scheduler.mode = CullMode::TwoPhase;
-            m.scheduler.tuning.recordPyramidSpan = static_cast<int>(std::min<std::uint32_t>(v, 1u << 20));
         } else if (param == "pyramid-ns") {
             m.scheduler.mode = CullMode::TwoPhase;
             m.scheduler.tuning.costs.pyramidNs = double(v);
