@@ -37,6 +37,7 @@ struct ModeSummary {
     /// Per frame, measured only by full-splitwaits (SchedulerTuning::splitDrawWaits): of
     /// depthReadMs and rasterMs the waits for drawing, and the pyramid tests' CPU.
     double drawWaitMs = 0, pyramidTestMs = 0;
+    double clusterPyramidTests = 0, clusterMs = 0;  ///< per frame (FrameStats::clusterPyramidTests, clusterMs)
     std::uint64_t largestRegion = 0;          ///< largest wrong region of any frame, pixels
     std::uint64_t timeouts = 0;               ///< queries that never answered, summed
     double ratioVfc = 0, ratioOracle = 0;     ///< msMean / that mode's msMean (0 if absent)

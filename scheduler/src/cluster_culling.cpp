@@ -17,9 +17,10 @@
 namespace dyncull {
 
 namespace {
-/// What clusterTest found: hidden, reaching the near plane (shows), in front and not
-/// rejected (its footprint filled in), or neither (no pyramid to test against).
-enum class ClusterTest : std::uint8_t { Hidden, Crossing, Passed, Untested };
+/// What clusterTest found: hidden without a projection (outside the frustum), hidden by
+/// the pyramid (or covering no pixel centre), reaching the near plane (shows), in front
+/// and not rejected (its footprint filled in), or neither (no pyramid to test against).
+enum class ClusterTest : std::uint8_t { Hidden, Behind, Crossing, Passed, Untested };
 
 /// Whether cluster `c` of an object with `matrix` (prepared as `object`) shows nothing:
 /// outside the frustum (if `frustum`: its part crosses it), or behind the depth pyramid (if
@@ -33,11 +34,11 @@ ClusterTest clusterTest(const QueryScheduler::Frame& f, const DepthPyramid* pyra
     BoxCorners corners;
     if (!f.screen.boxCentres(object, c.box, centres, nearest, texels > 0 ? &corners : nullptr)) return ClusterTest::Crossing;
     // A pyramid exists only for a single-sample target: a cluster covering no pixel centre draws nothing.
-    if (centres.empty() || pyramid->occluded(centres, nearest, span)) return ClusterTest::Hidden;
+    if (centres.empty() || pyramid->occluded(centres, nearest, span)) return ClusterTest::Behind;
     if (texels == 0) return ClusterTest::Passed;
     DepthPlanes planes;
     f.screen.frontFacePlanes(object, corners, planes);
-    return pyramid->occludedPerTexel(centres, nearest, planes, texels) ? ClusterTest::Hidden : ClusterTest::Passed;
+    return pyramid->occludedPerTexel(centres, nearest, planes, texels) ? ClusterTest::Behind : ClusterTest::Passed;
 }
 }  // namespace
 
@@ -126,7 +127,7 @@ void QueryScheduler::selectClusters(const Frame& f, const ClusterJob& job, Clust
     out.ranges.clear();
     out.rangeIds.clear();
     out.culledTriangles = out.deferredTriangles = out.drawnTriangles = 0;
-    out.culledClusters = out.deferred = out.drawn = 0;
+    out.culledClusters = out.deferred = out.drawn = out.pyramidTests = 0;
     const ClusterPass pass = job.pass;
     const std::uint32_t firstCluster = job.firstBit;
     const std::span<const LeafCluster> clusters = job.clusters;
@@ -150,7 +151,8 @@ void QueryScheduler::selectClusters(const Frame& f, const ClusterJob& job, Clust
             if (test == ClusterTest::Untested && (job.frustum || pyramid))
                 test = clusterTest(f, pyramid, params_.tuning.clusterPyramidSpan, params_.tuning.clusterTexelTests, job.matrix,
                                    job.object, c, job.frustum, learned.centres, learned.nearest);
-            culled = test == ClusterTest::Hidden;
+            culled = test == ClusterTest::Hidden || test == ClusterTest::Behind;
+            out.pyramidTests += test == ClusterTest::Behind || test == ClusterTest::Passed;
             learned.fate = culled ? LearnedCluster::Fate::Hidden
                            : test == ClusterTest::Crossing ? LearnedCluster::Fate::Crossing
                            : test == ClusterTest::Passed   ? LearnedCluster::Fate::Projected
@@ -202,6 +204,7 @@ void QueryScheduler::takeSelection(Frame& f, const ClusterJob& job, ClusterSelec
     }
     f.stats.clustersCulled += sel.culledClusters;
     f.stats.clusterTrianglesCulled += sel.culledTriangles;
+    f.stats.clusterPyramidTests += sel.pyramidTests;
     f.stats.clusterMs += sel.ms;
     if (job.keepLearned && job.recordIndex != kInvalidIndex) {
         assert(job.recordIndex < clusterPartLearned_.size() && sel.learned.size() == job.clusters.size());

@@ -103,12 +103,13 @@ std::span<const LeafCluster> partClusters(const SceneObjects& objs, NodeRef ref)
 }
 }  // namespace
 
-void QueryScheduler::recordVerdicts(const Frame& f, std::size_t first, std::span<const NodeRef> parts, bool sinkCullsBackFaces,
-                                    std::vector<std::uint8_t>& shown) const {
+std::uint32_t QueryScheduler::recordVerdicts(const Frame& f, std::size_t first, std::span<const NodeRef> parts, bool sinkCullsBackFaces,
+                                             std::vector<std::uint8_t>& shown) const {
     using Fate = LearnedCluster::Fate;
     const SceneObjects& objs = f.objects;
     const int span = params_.tuning.recordPyramidSpan;
     shown.clear();
+    std::uint32_t pyramidTests = 0;
     for (std::size_t p = 0; p < parts.size(); ++p) {
         const NodeRef ref = parts[p];
         const LocalBsp& model = objs.model(objs.modelOf(ref.object));
@@ -127,17 +128,22 @@ void QueryScheduler::recordVerdicts(const Frame& f, std::size_t first, std::span
             bool hidden = fate == Fate::Hidden;
             if (fate == Fate::Projected) {
                 hidden = pyramid_.occluded(learned[i].centres, learned[i].nearest, span);
+                ++pyramidTests;
             } else if (fate == Fate::Untested) {
                 // No guarantee needed here (a deferred cluster is tested in the late pass),
                 // so the box is projected roughly: in float, without rounding margins.
                 ScreenRect centres;
                 float nearest = 1.0f;
-                hidden = (cones && eye.backFacing(c)) ||
-                         (f.screen.roughBoxDepth(toClip, c.box, centres, nearest) && (centres.empty() || pyramid_.occluded(centres, nearest, span)));
+                hidden = cones && eye.backFacing(c);
+                if (!hidden) {
+                    hidden = f.screen.roughBoxDepth(toClip, c.box, centres, nearest) && (centres.empty() || pyramid_.occluded(centres, nearest, span));
+                    ++pyramidTests;
+                }
             }
             shown.push_back(hidden ? 0 : 1);
         }
     }
+    return pyramidTests;
 }
 
 void QueryScheduler::recordClusterVisibility(Frame& f) {
@@ -179,18 +185,20 @@ void QueryScheduler::recordClusterVisibility(Frame& f) {
     const std::span<const NodeRef> parts(clusterParts_);
     const bool cullsBackFaces = f.sink.cullsBackFaces();
     std::thread worker;
+    std::uint32_t lateTests = 0;
     if (split < clusterParts_.size()) {
         try {
-            worker = std::thread([this, &f, parts, split, cullsBackFaces] {
-                recordVerdicts(f, split, parts.subspan(split), cullsBackFaces, recordShownLate_);
+            worker = std::thread([this, &f, parts, split, cullsBackFaces, &lateTests] {
+                lateTests = recordVerdicts(f, split, parts.subspan(split), cullsBackFaces, recordShownLate_);
             });
         } catch (const std::system_error&) {
             split = clusterParts_.size();  // no thread to be had: all on this one
         }
     }
-    recordVerdicts(f, 0, parts.first(split), cullsBackFaces, recordShown_);
+    f.stats.clusterPyramidTests += recordVerdicts(f, 0, parts.first(split), cullsBackFaces, recordShown_);
     if (worker.joinable()) {
         worker.join();
+        f.stats.clusterPyramidTests += lateTests;
         recordShown_.insert(recordShown_.end(), recordShownLate_.begin(), recordShownLate_.end());
     }
     std::size_t next = 0;

@@ -57,6 +57,7 @@ struct QueryScheduler::ClusterSelection {
     std::vector<LearnedCluster> learned;  ///< with keepLearned: one per cluster of the job, in order
     std::uint64_t culledTriangles = 0, deferredTriangles = 0, drawnTriangles = 0;
     std::uint32_t culledClusters = 0, deferred = 0, drawn = 0;
+    std::uint32_t pyramidTests = 0;  ///< clusters projected against the pyramid (FrameStats::clusterPyramidTests)
     double ms = 0.0;  ///< spent testing
 };
 

@@ -59,6 +59,7 @@ protected:
         lp.maxLeafTriangles = r.maxLeafTriangles;
         const ModelId sphere = *engine_->addModel(test::sphereMesh(1.0f, 48, 96), lp);
         ASSERT_GT(engine_->objects().model(sphere).clusters.clusters.size(), 40u);
+        sceneClusters_ = engine_->objects().model(sphere).clusters.clusters.size() * std::size_t(r.count);
         const ModelId wall = *engine_->addModel(test::cubeMesh(1.0f));
         for (int i = 0; i < r.count; ++i) {
             const float a = 6.2831853f * float(i) / float(r.count), size = r.size + 0.1f * float(i % 4);
@@ -121,6 +122,7 @@ protected:
 
     std::unique_ptr<GlContext> ctx_;
     std::unique_ptr<Engine> engine_;
+    std::size_t sceneClusters_ = 0;  ///< the spheres' clusters (the wall has none)
 };
 using ClusterCulling = SphereRing;
 using ClusterHistory = SphereRing;
@@ -131,7 +133,7 @@ TEST_F(ClusterCulling, DrawsTheImageOfWholePartsAndCulls) {
     for (CullMode mode : {CullMode::Vfc, CullMode::TwoPhase}) {
         SCOPED_TRACE(toString(mode));
         QueryScheduler clustered(paramsOf(mode, true)), whole(paramsOf(mode, false));
-        std::uint64_t culledTriangles = 0, drawnClustered = 0, drawnWhole = 0;
+        std::uint64_t culledTriangles = 0, drawnClustered = 0, drawnWhole = 0, pyramidTests = 0;
         for (int f = 0; f < 12; ++f) {
             // Circling at the ring's radius: spheres near, far, behind the wall and half
             // outside the frustum's edges.
@@ -141,6 +143,11 @@ TEST_F(ClusterCulling, DrawsTheImageOfWholePartsAndCulls) {
             const FrameStats a2 = render(whole, wholeParts);
             EXPECT_EQ(differingPixels(withClusters, wholeParts), 0u) << "frame " << f;
             EXPECT_EQ(a2.clusterTests, 0u);
+            EXPECT_EQ(a2.clusterPyramidTests, 0u);
+            // A cluster meets a pyramid at most twice a frame: in the late pass (its part's,
+            // or as a deferred cluster of an early part) and in cluster history's record.
+            EXPECT_LE(a1.clusterPyramidTests, 2 * sceneClusters_);
+            pyramidTests += a1.clusterPyramidTests;
             culledTriangles += a1.clusterTrianglesCulled;
             drawnClustered += a1.trianglesDrawn;
             drawnWhole += a2.trianglesDrawn;
@@ -153,6 +160,12 @@ TEST_F(ClusterCulling, DrawsTheImageOfWholePartsAndCulls) {
         // good share of those lie in clusters that face away whole.
         EXPECT_GT(culledTriangles, drawnWhole / 5);
         EXPECT_LT(drawnClustered, drawnWhole);
+        // Only two-phase has a pyramid to test clusters against.
+        if (mode == CullMode::Vfc) {
+            EXPECT_EQ(pyramidTests, 0u);
+        } else {
+            EXPECT_GT(pyramidTests, 0u);
+        }
     }
 }
 

@@ -45,6 +45,10 @@ struct FrameStats {
     /// Two-phase: volumes hidden texel by texel (SchedulerTuning::texelTestTexels) that the
     /// pyramid test at its span let through; in depthTests already.
     std::uint32_t texelOccluded = 0;
+    /// Two-phase: clusters projected and compared with a depth pyramid: in the late pass
+    /// (the early pyramid, or one built again before a round) and in cluster history's
+    /// record (the final depth's). Volume tests as much as depthTests; their CPU is in clusterMs.
+    std::uint32_t clusterPyramidTests = 0;
     double clusterMs = 0.0;             ///< CPU in the cluster tests, and in the final-depth tests of cluster history
     std::uint64_t queryTriangles = 0;   ///< triangles of the query volumes drawn (12 per box)
     std::uint32_t queriesOccluded = 0;  ///< answered "occluded"

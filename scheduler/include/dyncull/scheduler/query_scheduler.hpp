@@ -696,9 +696,10 @@ private:
     void recordClusterVisibility(Frame& f);
     /// The record's verdicts for `parts`' clusters in order, 1 where a cluster shows: reads
     /// only the frame, the pyramid and the objects, so two threads can share the parts.
-    /// `first`: the index in clusterParts_ of `parts`' first (their LearnedCluster).
-    void recordVerdicts(const Frame& f, std::size_t first, std::span<const NodeRef> parts, bool sinkCullsBackFaces,
-                        std::vector<std::uint8_t>& shown) const;
+    /// `first`: the index in clusterParts_ of `parts`' first (their LearnedCluster). Returns
+    /// how many clusters it compared with the pyramid (FrameStats::clusterPyramidTests).
+    std::uint32_t recordVerdicts(const Frame& f, std::size_t first, std::span<const NodeRef> parts, bool sinkCullsBackFaces,
+                                 std::vector<std::uint8_t>& shown) const;
     std::vector<std::uint8_t> recordShown_, recordShownLate_;
     std::vector<double> recordPartNs_;  // each of clusterParts_' share of the record (TestCosts, ns)
     // useClusterMarks: the cluster each range of clusterRanges_ is (its index in its
