@@ -33,6 +33,20 @@ double boundOver(const DepthPlanes& p, float nearest, int x0, int y0, int x1, in
     return bound;
 }
 
+// Whether the centres of pixels [x0, x1] x [y0, y1] grown by kSnapPixels all lie outside
+// one of `p`'s outline edges (an affine function is least at a corner); the margin, 2^-30
+// of the terms, is far above the rounding of a sum of three doubles.
+bool outsideOutline(const DepthPlanes& p, int x0, int y0, int x1, int y1) {
+    constexpr double s = DepthPyramid::kSnapPixels;
+    const double lx = x0 + 0.5 - s, hx = x1 + 0.5 + s, ly = y0 + 0.5 - s, hy = y1 + 0.5 + s;
+    for (std::uint32_t i = 0; i < p.edgeCount; ++i) {
+        const auto& [a, b, c] = p.edges[i];
+        const double ax = a * (a > 0.0 ? lx : hx), by = b * (b > 0.0 ? ly : hy);
+        if (ax + by > c + 0x1p-30 * (std::abs(ax) + std::abs(by) + std::abs(c))) return true;
+    }
+    return false;
+}
+
 // Reversed Z: behind means smaller, by more than the slack (as hiddenAt compares).
 bool behind(double bound, float t) { return bound < double(t - DepthPyramid::kDepthSlack * t); }
 
@@ -167,7 +181,7 @@ bool DepthPyramid::occludedPerTexel(const ScreenRect& rect, float nearestDepth, 
         const Level& l = levels_[static_cast<std::size_t>(t.level)];
         const float farthest =
             levelData(static_cast<std::size_t>(t.level))[static_cast<std::size_t>(t.y) * static_cast<std::size_t>(l.width) + static_cast<std::size_t>(t.x)];
-        if (behind(boundOver(planes, nearestDepth, px0, py0, px1, py1), farthest)) continue;
+        if (behind(boundOver(planes, nearestDepth, px0, py0, px1, py1), farthest) || outsideOutline(planes, px0, py0, px1, py1)) continue;
         if (t.level == 0 || ++visited >= maxTexels) return false;
         const int k = t.level - 1;
         for (int cy = py0 >> k; cy <= (py1 >> k); ++cy)
@@ -186,7 +200,7 @@ bool occludedPerPixelBruteForce(std::span<const float> depth, int width, int hei
     for (int y = y0; y <= y1; ++y)
         for (int x = x0; x <= x1; ++x) {
             const float d = depth[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)];
-            if (!behind(boundOver(planes, nearestDepth, x, y, x, y), d)) return false;
+            if (!behind(boundOver(planes, nearestDepth, x, y, x, y), d) && !outsideOutline(planes, x, y, x, y)) return false;
         }
     return true;
 }

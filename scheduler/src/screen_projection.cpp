@@ -206,17 +206,51 @@ ScreenProjection::BoxNdc ScreenProjection::boxNdc(const ObjectProjection& object
     return BoxNdc::InFront;
 }
 
+void ScreenProjection::outline(const std::array<glm::dvec3, 8>& corners, DepthPlanes& out) const {
+    // The box lies in front of the eye, so its projection is the convex hull of its
+    // corners' (Andrew's monotone chain, counter-clockwise; collinear corners dropped).
+    const double fx = 0.5 * view_.width, fy = 0.5 * view_.height;
+    std::array<glm::dvec2, 8> p;
+    for (std::size_t i = 0; i < 8; ++i) p[i] = {(corners[i].x + 1.0) * fx, (corners[i].y + 1.0) * fy};
+    std::sort(p.begin(), p.end(), [](const glm::dvec2& u, const glm::dvec2& v) { return u.x < v.x || (u.x == v.x && u.y < v.y); });
+    auto turnsLeft = [](const glm::dvec2& o, const glm::dvec2& u, const glm::dvec2& v) {
+        return (u.x - o.x) * (v.y - o.y) - (u.y - o.y) * (v.x - o.x) > 0.0;
+    };
+    std::array<glm::dvec2, 16> hull;
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < 8; ++i) {  // lower chain
+        while (k >= 2 && !turnsLeft(hull[k - 2], hull[k - 1], p[i])) --k;
+        hull[k++] = p[i];
+    }
+    for (std::size_t i = 7, lower = k + 1; i-- > 0;) {  // upper chain
+        while (k >= lower && !turnsLeft(hull[k - 2], hull[k - 1], p[i])) --k;
+        hull[k++] = p[i];
+    }
+    // hull[k - 1] repeats hull[0]. Fewer than two distinct points: no outline (all of the
+    // footprint may be covered); two: the segment's two sides.
+    const std::size_t n = k - 1;
+    if (n < 2) return;
+    for (std::size_t i = 0; i < n && out.edgeCount < DepthPlanes::kMaxEdges; ++i) {
+        const glm::dvec2 a = hull[i], d = hull[i + 1] - a;
+        // Left of a -> a + d: d.y x - d.x y <= d.y a.x - d.x a.y.
+        out.edges[out.edgeCount++] = {d.y, -d.x, d.y * a.x - d.x * a.y};
+    }
+}
+
 void ScreenProjection::frontFacePlanes(const ObjectProjection& object, const BoxCorners& box, DepthPlanes& out) const {
     // A face is front-facing when the eye lies outside its plane, judged in object space
     // with a margin of 2^-20 of the magnitudes (far above the rounding of the inverse): a
     // back face taken for a front one would bound the depth by the box's far side, so
     // a face too close to call is left out.
     out.count = 0;
-    if (!object.eyeKnown || !box.valid) return;
-    const glm::dvec3& centre = box.centre;
-    const glm::dvec3& half = box.half;
+    out.edgeCount = 0;
+    if (!box.valid) return;
     const std::array<glm::dvec3, 8>& corners = box.window;
     const double fx = 0.5 * view_.width, fy = 0.5 * view_.height;
+    outline(corners, out);
+    if (!object.eyeKnown) return;
+    const glm::dvec3& centre = box.centre;
+    const glm::dvec3& half = box.half;
     for (int a = 0; a < 3; ++a) {
         const double outside = std::abs(object.eyeLocal[a] - centre[a]) - half[a];
         if (!(outside > 0x1p-20 * (std::abs(object.eyeLocal[a]) + std::abs(centre[a]) + half[a]))) continue;
@@ -296,6 +330,7 @@ bool ScreenProjection::pointsDepth(const glm::dvec3* rel, std::uint32_t n, Depth
     out.centres = centreRect(lo, hi);
     out.nearest = static_cast<float>(nearest);
     out.planes.count = 0;
+    out.planes.edgeCount = 0;
     return true;
 }
 

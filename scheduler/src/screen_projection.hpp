@@ -94,7 +94,8 @@ public:
     bool boxCentres(const ObjectProjection& object, const Aabb& local, ScreenRect& centres, float& nearestDepth,
                     BoxCorners* corners = nullptr) const;
     /// The planes of the front faces of a box that boxCentres kept `corners` of, projected
-    /// with `object` (DepthFootprint::planes); none if the corners are not valid.
+    /// with `object` (DepthFootprint::planes), and its outline; none if the corners are not
+    /// valid.
     void frontFacePlanes(const ObjectProjection& object, const BoxCorners& corners, DepthPlanes& out) const;
     /// A guess, for choices that need no guarantee (cluster history's record of what
     /// showed): the pixels whose centres box `local` under `objectToClip` (object space to
@@ -111,6 +112,8 @@ public:
     ScreenRect centreRect(const glm::dvec2& lo, const glm::dvec2& hi) const;
 
 private:
+    /// The outline of a box in front of the eye from its projected corners (DepthPlanes::edges).
+    void outline(const std::array<glm::dvec3, 8>& corners, DepthPlanes& out) const;
     /// The distance along the view direction of eye-relative point `rel` whose clip
     /// coordinates are `clip`: clip w in perspective, along distanceRow_ in orthographic.
     double viewDistance(const glm::dvec4& clip, const glm::dvec3& rel) const {

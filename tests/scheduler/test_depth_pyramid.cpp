@@ -116,6 +116,16 @@ TEST(DepthPyramid, PerTexelTestNeverHidesWhatThePixelOracleShows) {
                 const double scale = (i % 3 == 0) ? 10.0 : 1.0;  // some planes steep
                 planes.planes[k] = {slope(rng) * scale, slope(rng) * scale, base + 0.3 * (u(rng) - 0.5)};
             }
+            // Half the cases with an outline: random half-planes through points near the
+            // rectangle (at times empty, at times cutting it to a sliver).
+            if (i % 2 == 1) {
+                planes.edgeCount = static_cast<std::uint32_t>(std::uniform_int_distribution<int>(1, 8)(rng));
+                for (std::uint32_t k = 0; k < planes.edgeCount; ++k) {
+                    const double angle = 6.283185307179586 * u(rng);
+                    const double px = r.x0 + (r.x1 - r.x0) * (1.4 * u(rng) - 0.2), py = r.y0 + (r.y1 - r.y0) * (1.4 * u(rng) - 0.2);
+                    planes.edges[k] = {std::cos(angle), std::sin(angle), std::cos(angle) * px + std::sin(angle) * py};
+                }
+            }
             const float nearest = static_cast<float>(u(rng));
             const bool truth = occludedPerPixelBruteForce(b.depth, b.width, b.height, r, nearest, planes);
             for (const int budget : {1, 16, 256}) {
@@ -158,6 +168,38 @@ TEST(DepthPyramid, APlaneHidesASlantedSurfaceTheNearestDepthCannot) {
     depth[static_cast<std::size_t>(5 * w + 40)] = 0.0f;
     p.build(depth, w, h);
     EXPECT_FALSE(p.occludedPerTexel(all, nearest, planes, 1 << 20));
+}
+
+// A box seen corner-on covers a diamond of its rectangle: the rectangle's corners show the
+// far background, which hides nothing, and the diamond a near wall. Its outline leaves the
+// corners out, and the wall hides it; without the outline it shows.
+TEST(DepthPyramid, AnOutlineLeavesOutThePixelsTheVolumeCannotCover) {
+    const int w = 32, h = 32;
+    std::vector<float> depth(static_cast<std::size_t>(w * h), 0.0f);  // cleared: the far plane
+    auto inDiamond = [](double x, double y, double slack) { return std::abs(x - 16.0) + std::abs(y - 16.0) <= 12.0 + slack; };
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            if (inDiamond(x + 0.5, y + 0.5, 1.0)) depth[static_cast<std::size_t>(y * w + x)] = 0.8f;
+    DepthPyramid p;
+    p.build(depth, w, h);
+    DepthPlanes planes;
+    // |x - 16| + |y - 16| <= 12 as four half-planes.
+    planes.edgeCount = 4;
+    planes.edges[0] = {1.0, 1.0, 44.0};
+    planes.edges[1] = {-1.0, 1.0, 12.0};
+    planes.edges[2] = {-1.0, -1.0, -20.0};
+    planes.edges[3] = {1.0, -1.0, 12.0};
+    const ScreenRect r{4, 4, 28, 28};
+    const float nearest = 0.5f;
+    EXPECT_TRUE(p.occludedPerTexel(r, nearest, planes, 1 << 20));
+    EXPECT_TRUE(occludedPerPixelBruteForce(depth, w, h, r, nearest, planes));
+    DepthPlanes none;
+    EXPECT_FALSE(p.occludedPerTexel(r, nearest, none, 1 << 20));
+    EXPECT_FALSE(occludedPerPixelBruteForce(depth, w, h, r, nearest, none));
+    // A background pixel inside the outline shows the volume.
+    depth[static_cast<std::size_t>(16 * w + 16)] = 0.0f;
+    p.build(depth, w, h);
+    EXPECT_FALSE(p.occludedPerTexel(r, nearest, planes, 1 << 20));
 }
 
 TEST(DepthPyramid, ShortCutAnswersAsReadingEveryTexelOfTheSpanLevel) {

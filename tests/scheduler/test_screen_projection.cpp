@@ -141,11 +141,12 @@ TEST(ScreenProjection, RoughBoxDepthIsTheExactFootprintWithinRounding) {
 
 // boxDepth's front-face planes bound the box's depth pixel by pixel: every point of the box
 // (corners, points on its faces, inside) projects no nearer than each plane's depth at its
-// own window position. Perspective only; an orthographic view gets no planes.
+// own window position, and inside its outline. Planes in perspective only (an orthographic
+// view gets none); the outline in both.
 TEST(ScreenProjection, FrontFacePlanesAreNeverBehindTheBox) {
     std::mt19937 rng(23);
     std::uniform_real_distribution<double> u(0.0, 1.0);
-    int withPlanes = 0, points = 0;
+    int withPlanes = 0, withOutline = 0, points = 0;
     for (const float scale : {1.0f, 1e-3f, 1e4f}) {
         for (int i = 0; i < 400; ++i) {
             const Case c = randomCase(rng, false, scale);
@@ -155,6 +156,7 @@ TEST(ScreenProjection, FrontFacePlanesAreNeverBehindTheBox) {
             if (!screen.boxDepth(screen.objectProjection(c.matrix), c.box, fp)) continue;
             ASSERT_LE(fp.planes.count, 3u);
             withPlanes += fp.planes.count > 0;
+            withOutline += fp.planes.edgeCount >= 4;  // a box's outline has 4 or 6 corners
             for (int k = 0; k < 64; ++k) {
                 // Corners first, then points on the faces, then inside.
                 glm::dvec3 t(u(rng), u(rng), u(rng));
@@ -169,11 +171,17 @@ TEST(ScreenProjection, FrontFacePlanesAreNeverBehindTheBox) {
                     const auto& [a, b, d0] = fp.planes.planes[j];
                     EXPECT_GE(a * px.x + b * px.y + d0, depth - 1e-9 * std::abs(depth)) << "case " << i << ", plane " << j;
                 }
+                for (std::uint32_t j = 0; j < fp.planes.edgeCount; ++j) {
+                    const auto& [a, b, d0] = fp.planes.edges[j];
+                    EXPECT_LE(a * px.x + b * px.y, d0 + 1e-9 * (std::abs(a * px.x) + std::abs(b * px.y) + std::abs(d0)))
+                        << "case " << i << ", edge " << j;
+                }
                 ++points;
             }
         }
     }
     EXPECT_GT(withPlanes, 300) << "too few boxes with planes to check";
+    EXPECT_GT(withOutline, 300) << "too few boxes with outlines to check";
     EXPECT_GT(points, 20000);
     // Orthographic: none.
     const Case c = randomCase(rng, true, 1.0f);
@@ -182,6 +190,7 @@ TEST(ScreenProjection, FrontFacePlanesAreNeverBehindTheBox) {
     DepthFootprint fp;
     if (screen.boxDepth(screen.objectProjection(c.matrix), c.box, fp)) {
         EXPECT_EQ(fp.planes.count, 0u);
+        EXPECT_GE(fp.planes.edgeCount, 4u);
     }
 }
 

@@ -30,10 +30,17 @@ namespace dyncull {
 /// its nearest depth is at most each plane's depth there (reversed Z, nearer is greater).
 /// Any subset of the front faces' planes is such a bound, so a face too close to edge-on
 /// to be trusted is left out. Filled by ScreenProjection::boxDepth.
+/// With them, the volume's outline: the convex hull of its projected corners, as the
+/// half-planes a x + b y <= c in the same pixel coordinates. The volume covers no point
+/// outside it, so a pixel whose centre (grown as the bounds are) lies outside one of them
+/// is not the volume's, whatever its depth. No edges: the whole footprint may be covered.
 struct DepthPlanes {
     static constexpr std::size_t kMax = 3;  ///< a box shows at most three faces
     std::array<std::array<double, 3>, kMax> planes{};  ///< {a, b, c}; [0, count) used
     std::uint32_t count = 0;
+    static constexpr std::size_t kMaxEdges = 8;  ///< a hull of 8 corners
+    std::array<std::array<double, 3>, kMaxEdges> edges{};  ///< {a, b, c}; [0, edgeCount) used
+    std::uint32_t edgeCount = 0;
 };
 
 /// Depths are window depths in dyncull's reversed-Z convention (objects/camera.hpp): 1 at
@@ -85,8 +92,9 @@ public:
     /// pixel it may not be behind makes it visible. `rect` holds the pixels whose centres
     /// the surface can cover (DepthFootprint::centres); each bound is taken over their
     /// centres grown by kSnapPixels, where a rasteriser's snapping may move a surface
-    /// point. Gives up, answering visible, after `maxTexels` texels (>= 1). With no planes
-    /// it reads down to single pixels too, against nearestDepth alone.
+    /// point. A texel whose pixels all lie outside the planes' outline is settled too.
+    /// Gives up, answering visible, after `maxTexels` texels (>= 1). With no planes it
+    /// reads down to single pixels too, against nearestDepth alone.
     bool occludedPerTexel(const ScreenRect& rect, float nearestDepth, const DepthPlanes& planes, int maxTexels) const;
 
     /// How far a rasteriser may move a vertex when it snaps it to its sub-pixel grid, in
@@ -131,7 +139,7 @@ private:
 /// The oracle of occludedPerTexel, pixel by pixel: true only if at every pixel of `rect`
 /// (clamped to the screen) the surface's bound (nearestDepth, and each plane's depth over
 /// the pixel's centre grown by DepthPyramid::kSnapPixels) lies behind the pixel's depth by
-/// more than DepthPyramid::kDepthSlack.
+/// more than DepthPyramid::kDepthSlack, or that grown centre lies outside the outline.
 bool occludedPerPixelBruteForce(std::span<const float> depth, int width, int height, const ScreenRect& rect, float nearestDepth,
                                 const DepthPlanes& planes);
 
