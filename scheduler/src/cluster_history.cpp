@@ -149,6 +149,9 @@ std::uint32_t QueryScheduler::recordVerdicts(const Frame& f, std::size_t first, 
 void QueryScheduler::recordClusterVisibility(Frame& f) {
     // The final depth holds every occluder the frame drew, so it hides the most clusters;
     // what it says only chooses next frame's early draws.
+    // Read already by the parts' refresh, which would otherwise have taken a round of
+    // raster tests (TestCosts::testNsPerBatch): the record pays only what the read costs more.
+    const bool sharedRead = f.finalPyramid;
     if (!readFinalPyramid(f)) return;  // the bits stay as they were
     const auto t1 = SchedulerClock::now();
     const SceneObjects& objs = f.objects;
@@ -216,7 +219,8 @@ void QueryScheduler::recordClusterVisibility(Frame& f) {
     // Timed, it swung with the frame (a wait for the drawing, a thread descheduled on two
     // cores), and one slow frame turned the record off until the next probe.
     const double threads = split < clusterParts_.size() ? 2.0 : 1.0;
-    clusterRecordNs_ = costs.pyramidNs + totalNs / threads;
+    const double readNs = sharedRead ? std::max(0.0, costs.pyramidNs - costs.testNsPerBatch) : costs.pyramidNs;
+    clusterRecordNs_ = readNs + totalNs / threads;
     lastClusterRecordFrame_ = f.index;
 }
 

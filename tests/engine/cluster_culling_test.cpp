@@ -344,6 +344,44 @@ TEST_F(ClusterHistory, TheRecordIsPricedFromCountsSoTwinsDecideAlike) {
     EXPECT_EQ(ctx_->checkErrors(), 0u);
 }
 
+TEST_F(ClusterHistory, ARecordSharingTheRefreshsReadIsNotChargedForIt) {
+    // Where the parts' refresh has read the final depth already, the record's read would
+    // otherwise have been the refresh's round of raster tests: it is priced at what it
+    // costs beyond that round (pyramidNs - testNsPerBatch), not at pyramidNs. With both
+    // at a price above any saving and the projections free, a record that shares the read
+    // runs in more frames than one charged for it in full.
+    build({2000, 8, 3.2f, 1.0f, {2.2f, 1.6f, 2.2f}});
+    if (HasFatalFailure()) return;
+    SchedulerParams shared = paramsOf(CullMode::TwoPhase, true);
+    shared.features.useCostModel = true;
+    shared.tuning.costs.depthReadNs = 0.0;  // the frame's tests always pay: only the record's model is in play
+    shared.tuning.costs.probeFrames = 8;
+    shared.tuning.costs.recordNsPerCluster = shared.tuning.costs.recordNsPerLearned = 0.0;
+    shared.tuning.costs.pyramidNs = shared.tuning.costs.testNsPerBatch = 1e12;
+    SchedulerParams charged = shared;
+    charged.tuning.costs.testNsPerBatch = 0.0;
+    QueryScheduler a(shared), b(charged), vfc(paramsOf(CullMode::Vfc, true));
+    constexpr int kFrames = 24;
+    int deferringShared = 0, deferringCharged = 0;
+    for (int f = 0; f < kFrames; ++f) {
+        SCOPED_TRACE("frame " + std::to_string(f));
+        circle(0.12f * float(f), 8.0f, 1.0f);
+        Image images[3];
+        const FrameStats x = render(a, images[0]);
+        const FrameStats y = render(b, images[1]);
+        render(vfc, images[2]);
+        EXPECT_EQ(differingPixels(images[0], images[2]), 0u);
+        EXPECT_EQ(differingPixels(images[1], images[2]), 0u);
+        deferringShared += x.clustersDeferred > 0;
+        deferringCharged += y.clustersDeferred > 0;
+    }
+    std::printf("frames deferring clusters: %d with the shared read priced beyond a round, %d charged in full (of %d)\n",
+                deferringShared, deferringCharged, kFrames);
+    EXPECT_LE(deferringCharged, 1 + kFrames / 8);  // the probes, and frame 1
+    EXPECT_GT(deferringShared, deferringCharged);
+    EXPECT_EQ(ctx_->checkErrors(), 0u);
+}
+
 TEST_F(ClusterHistory, TheRefreshSharesTheRecordsReadAndKeepsTheImage) {
     // The parts drawn early are tested for next frame against the pyramid of the final
     // depth that the record reads anyway (useRefreshPyramid), not in a batched raster test

@@ -219,7 +219,9 @@ inline std::uint64_t errorBudgetPixels(double percent, int width, int height) {
 /// depth drawn so far culls beyond the early one (27% on the power plant, 39% on the city,
 /// 60% on the bunny path), are worth more drawing than `pyramidNs`, a depth read that
 /// waits for nothing and the build (`bench_volume_tests`, `bench_depth_pyramid`). Cluster
-/// history's record at the frame's end is priced the same: `pyramidNs` plus
+/// history's record at the frame's end is priced the same: `pyramidNs` (less
+/// `testNsPerBatch` where the parts' refresh read that depth already, whose round of raster
+/// tests the read replaced) plus
 /// `recordNsPerCluster` per cluster it projects (`BM_ClusterRecord`) and
 /// `recordNsPerLearned` per cluster whose footprint the frame's own tests handed it
 /// (`BM_ClusterRecordLearned`), over the threads that share them (counts, not its time: a
