@@ -19,29 +19,34 @@ bool clampRect(const ScreenRect& rect, int width, int height, int& x0, int& y0, 
     return x0 <= x1 && y0 <= y1;
 }
 
-// The greatest depth the least of `p`'s planes takes over the centres of pixels
-// [x0, x1] x [y0, y1] grown by kSnapPixels (an affine function peaks at a corner), and at
-// most `nearest`.
-double boundOver(const DepthPlanes& p, float nearest, int x0, int y0, int x1, int y1) {
+// The centres of pixels [x0, x1] x [y0, y1] grown by kSnapPixels, where a rasteriser's
+// snapping may move a surface point: the rectangle the planes and the outline are judged over.
+struct GrownCentres {
+    double lx, ly, hx, hy;
+};
+GrownCentres grownCentres(int x0, int y0, int x1, int y1) {
     constexpr double s = DepthPyramid::kSnapPixels;
-    const double lx = x0 + 0.5 - s, hx = x1 + 0.5 + s, ly = y0 + 0.5 - s, hy = y1 + 0.5 + s;
+    return {x0 + 0.5 - s, y0 + 0.5 - s, x1 + 0.5 + s, y1 + 0.5 + s};
+}
+
+// The greatest depth the least of `p`'s planes takes over `g` (an affine function peaks at
+// a corner), and at most `nearest`.
+double boundOver(const DepthPlanes& p, float nearest, const GrownCentres& g) {
     double bound = nearest;
     for (std::uint32_t i = 0; i < p.count; ++i) {
         const auto& [a, b, c] = p.planes[i];
-        bound = std::min(bound, c + a * (a > 0.0 ? hx : lx) + b * (b > 0.0 ? hy : ly));
+        bound = std::min(bound, c + a * (a > 0.0 ? g.hx : g.lx) + b * (b > 0.0 ? g.hy : g.ly));
     }
     return bound;
 }
 
-// Whether the centres of pixels [x0, x1] x [y0, y1] grown by kSnapPixels all lie outside
-// one of `p`'s outline edges (an affine function is least at a corner); the margin, 2^-30
-// of the terms, is far above the rounding of a sum of three doubles.
-bool outsideOutline(const DepthPlanes& p, int x0, int y0, int x1, int y1) {
-    constexpr double s = DepthPyramid::kSnapPixels;
-    const double lx = x0 + 0.5 - s, hx = x1 + 0.5 + s, ly = y0 + 0.5 - s, hy = y1 + 0.5 + s;
+// Whether all of `g` lies outside one of `p`'s outline edges (an affine function is least
+// at a corner); the margin, 2^-30 of the terms, is far above the rounding of a sum of three
+// doubles.
+bool outsideOutline(const DepthPlanes& p, const GrownCentres& g) {
     for (std::uint32_t i = 0; i < p.edgeCount; ++i) {
         const auto& [a, b, c] = p.edges[i];
-        const double ax = a * (a > 0.0 ? lx : hx), by = b * (b > 0.0 ? ly : hy);
+        const double ax = a * (a > 0.0 ? g.lx : g.hx), by = b * (b > 0.0 ? g.ly : g.hy);
         if (ax + by > c + 0x1p-30 * (std::abs(ax) + std::abs(by) + std::abs(c))) return true;
     }
     return false;
@@ -181,7 +186,8 @@ bool DepthPyramid::occludedPerTexel(const ScreenRect& rect, float nearestDepth, 
         const Level& l = levels_[static_cast<std::size_t>(t.level)];
         const float farthest =
             levelData(static_cast<std::size_t>(t.level))[static_cast<std::size_t>(t.y) * static_cast<std::size_t>(l.width) + static_cast<std::size_t>(t.x)];
-        if (behind(boundOver(planes, nearestDepth, px0, py0, px1, py1), farthest) || outsideOutline(planes, px0, py0, px1, py1)) continue;
+        const GrownCentres g = grownCentres(px0, py0, px1, py1);
+        if (behind(boundOver(planes, nearestDepth, g), farthest) || outsideOutline(planes, g)) continue;
         if (t.level == 0 || ++visited >= maxTexels) return false;
         const int k = t.level - 1;
         for (int cy = py0 >> k; cy <= (py1 >> k); ++cy)
@@ -200,7 +206,8 @@ bool occludedPerPixelBruteForce(std::span<const float> depth, int width, int hei
     for (int y = y0; y <= y1; ++y)
         for (int x = x0; x <= x1; ++x) {
             const float d = depth[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)];
-            if (!behind(boundOver(planes, nearestDepth, x, y, x, y), d) && !outsideOutline(planes, x, y, x, y)) return false;
+            const GrownCentres g = grownCentres(x, y, x, y);
+            if (!behind(boundOver(planes, nearestDepth, g), d) && !outsideOutline(planes, g)) return false;
         }
     return true;
 }
