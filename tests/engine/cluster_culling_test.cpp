@@ -120,6 +120,16 @@ protected:
         EXPECT_EQ(ctx_->checkErrors(), 0u);
     }
 
+    /// Two-phase with the cost model where only cluster history's record is priced: the
+    /// frame's tests always pay, and a probe comes every 8 frames.
+    static SchedulerParams recordPricedParams() {
+        SchedulerParams p = paramsOf(CullMode::TwoPhase, true);
+        p.features.useCostModel = true;
+        p.tuning.costs.depthReadNs = 0.0;
+        p.tuning.costs.probeFrames = 8;
+        return p;
+    }
+
     std::unique_ptr<GlContext> ctx_;
     std::unique_ptr<Engine> engine_;
     std::size_t sceneClusters_ = 0;  ///< the spheres' clusters (the wall has none)
@@ -308,10 +318,7 @@ TEST_F(ClusterHistory, TheRecordIsPricedFromCountsSoTwinsDecideAlike) {
     // only ones that defer clusters; priced at nothing, it runs wherever it saved something.
     build({2000, 8, 3.2f, 1.0f, {2.2f, 1.6f, 2.2f}});
     if (HasFatalFailure()) return;
-    SchedulerParams cheap = paramsOf(CullMode::TwoPhase, true);
-    cheap.features.useCostModel = true;
-    cheap.tuning.costs.depthReadNs = 0.0;  // the frame's tests always pay: only the record's model is in play
-    cheap.tuning.costs.probeFrames = 8;
+    SchedulerParams cheap = recordPricedParams();
     SchedulerParams dear = cheap;
     cheap.tuning.costs.pyramidNs = 0.0;
     cheap.tuning.costs.recordNsPerCluster = 0.0;
@@ -352,10 +359,7 @@ TEST_F(ClusterHistory, ARecordSharingTheRefreshsReadIsNotChargedForIt) {
     // runs in more frames than one charged for it in full.
     build({2000, 8, 3.2f, 1.0f, {2.2f, 1.6f, 2.2f}});
     if (HasFatalFailure()) return;
-    SchedulerParams shared = paramsOf(CullMode::TwoPhase, true);
-    shared.features.useCostModel = true;
-    shared.tuning.costs.depthReadNs = 0.0;  // the frame's tests always pay: only the record's model is in play
-    shared.tuning.costs.probeFrames = 8;
+    SchedulerParams shared = recordPricedParams();
     shared.tuning.costs.recordNsPerCluster = shared.tuning.costs.recordNsPerLearned = 0.0;
     shared.tuning.costs.pyramidNs = shared.tuning.costs.testNsPerBatch = 1e12;
     SchedulerParams charged = shared;
