@@ -218,6 +218,28 @@ Aabb objectNodeBox(const SceneObjects& objs, NodeRef ref, VolumeChoice volume) {
     return box;
 }
 
+glm::dmat4 boxFrame(std::span<const glm::vec3, 8> corners) {
+    // Corner i is the centre plus or minus half axis k as bit k of i is set or clear: the
+    // sums over all eight cancel the other axes, and average the corners' roundings.
+    glm::dvec3 centre(0.0), axes[3] = {glm::dvec3(0.0), glm::dvec3(0.0), glm::dvec3(0.0)};
+    for (std::size_t i = 0; i < 8; ++i) {
+        const glm::dvec3 c(corners[i]);
+        centre += c;
+        for (std::size_t k = 0; k < 3; ++k) axes[k] += (i >> k) & 1 ? c : -c;
+    }
+    return glm::dmat4(glm::dvec4(axes[0] / 8.0, 0.0), glm::dvec4(axes[1] / 8.0, 0.0), glm::dvec4(axes[2] / 8.0, 0.0),
+                      glm::dvec4(centre / 8.0, 1.0));
+}
+
+std::optional<glm::dmat4> objectNodeObbFrame(const SceneObjects& objs, NodeRef ref) {
+    assert(!ref.isSceneNode());
+    const LocalBsp& model = objs.model(objs.modelOf(ref.object));
+    if (model.volumes.nodeCount() != model.nodes.size()) return std::nullopt;
+    const NodeVolume& v = model.volumes.get(ref.node, VolumeKind::Obb);
+    if (v.vertexCount != 8 || !v.isBox()) return std::nullopt;
+    return glm::dmat4(objs.matrix(ref.object)) * boxFrame(model.volumes.verticesOf(v).first<8>());
+}
+
 QueryVolume objectNodeVolume(const SceneObjects& objs, NodeRef ref, VolumeChoice volume, float autoSaving) {
     assert(!ref.isSceneNode());
     const LocalBsp& model = objs.model(objs.modelOf(ref.object));

@@ -133,9 +133,11 @@ bool ScreenProjection::volumeDepth(const QueryVolume& volume, DepthFootprint& ou
     return pointsDepth(rel.data(), n, out);
 }
 
-ObjectProjection ScreenProjection::objectProjection(const glm::mat4& matrix) const {
+ObjectProjection ScreenProjection::objectProjection(const glm::mat4& matrix) const { return objectProjection(glm::dmat4(matrix)); }
+
+ObjectProjection ScreenProjection::objectProjection(const glm::dmat4& matrix) const {
     ObjectProjection p;
-    p.toWorld = glm::dmat4(matrix);
+    p.toWorld = matrix;
     const glm::dvec3 c0(p.toWorld[0]), c1(p.toWorld[1]), c2(p.toWorld[2]);
     const double det = std::abs(glm::dot(c0, glm::cross(c1, c2)));
     const double a0 = glm::length(glm::cross(c1, c2)), a1 = glm::length(glm::cross(c2, c0)), a2 = glm::length(glm::cross(c0, c1));
@@ -272,17 +274,29 @@ void ScreenProjection::frontFacePlanes(const ObjectProjection& object, const Box
     }
 }
 
-bool ScreenProjection::boxDepth(const ObjectProjection& object, const Aabb& local, DepthFootprint& out) const {
+bool ScreenProjection::boxDepth(const ObjectProjection& object, const Aabb& local, DepthFootprint& out, bool planes) const {
+    if (const std::optional<bool> inFront = frameBoxDepth(object, local, out, planes)) return *inFront;
+    // Too thin: as a box of boxes; the float matrix is toWorld rounded back, exactly.
+    return volumeDepth(QueryVolume::fromTransformedBox(glm::mat4(object.toWorld), local), out);
+}
+
+std::optional<bool> ScreenProjection::frameBoxDepth(const ObjectProjection& object, const Aabb& local, DepthFootprint& out,
+                                                    bool planes) const {
     glm::dvec2 lo, hi;
     double nearest = 0.0;
     BoxCorners corners;
-    switch (boxNdc(object, local, lo, hi, nearest, &corners)) {
+    switch (boxNdc(object, local, lo, hi, nearest, planes ? &corners : nullptr)) {
     case BoxNdc::Crossing: return false;
-    case BoxNdc::Thin:  // as a box of boxes; the float matrix is toWorld rounded back, exactly
-        return volumeDepth(QueryVolume::fromTransformedBox(glm::mat4(object.toWorld), local), out);
+    case BoxNdc::Thin: return std::nullopt;
     case BoxNdc::InFront: break;
     }
-    frontFacePlanes(object, corners, out.planes);
+    out.planesLeftOut = !planes;
+    if (planes) {
+        frontFacePlanes(object, corners, out.planes);
+    } else {
+        out.planes.count = 0;
+        out.planes.edgeCount = 0;
+    }
     out.rect = pixelRect(lo, hi);
     out.centres = centreRect(lo, hi);
     out.nearest = static_cast<float>(nearest);
@@ -331,6 +345,7 @@ bool ScreenProjection::pointsDepth(const glm::dvec3* rel, std::uint32_t n, Depth
     out.nearest = static_cast<float>(nearest);
     out.planes.count = 0;
     out.planes.edgeCount = 0;
+    out.planesLeftOut = false;  // a volume has none to make
     return true;
 }
 

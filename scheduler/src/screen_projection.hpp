@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <optional>
 
 #include <glm/glm.hpp>
 
@@ -29,12 +30,15 @@ struct DepthFootprint {
     /// Its nearest depth pixel by pixel, bounded by its front faces' planes: set by boxDepth
     /// (none from volumeDepth); what DepthPyramid::occludedPerTexel reads.
     DepthPlanes planes;
+    /// A box's footprint made without its planes and outline (boxDepth with `planes` off):
+    /// `planes` is empty until it is made again with them, where a test needs them.
+    bool planesLeftOut = false;
 };
 
 /// One object's matrix prepared for the footprints of many boxes in its object space (a
 /// part's clusters): ScreenProjection::boxDepth's per-object terms, computed once. Double.
 struct ObjectProjection {
-    glm::dmat4 toWorld{1.0};  ///< object space to world space (the float matrix, exactly)
+    glm::dmat4 toWorld{1.0};  ///< object space to world space (for boxDepth the float matrix, exactly)
     /// Per axis i: how far the transformed box's two faces across axis i lie from its centre,
     /// per unit of the box's half extent along i (|det| / |column j x column k| of the
     /// matrix's linear part); 0 for a singular matrix.
@@ -81,13 +85,22 @@ public:
     const ObjectProjection& worldProjection() const { return world_; }
     /// `matrix` (object to world) prepared for boxDepth.
     ObjectProjection objectProjection(const glm::mat4& matrix) const;
+    /// The same for a matrix composed in double (an OBB's frame under its object's
+    /// matrix), for frameBoxDepth.
+    ObjectProjection objectProjection(const glm::dmat4& matrix) const;
     /// volumeDepth(QueryVolume::fromTransformedBox(matrix, local), out) for the matrix that
     /// `object` was prepared from, without building the volume: the box's centre and half
     /// axes are transformed once in double and its corners combined from them, and the
     /// faces' distances come from ObjectProjection::faceScale instead of the 12 triangles.
     /// The same margins for rounding, from the exact corners instead of their float
     /// roundings; a box too thin for them goes through volumeDepth.
-    bool boxDepth(const ObjectProjection& object, const Aabb& local, DepthFootprint& out) const;
+    /// With `planes` off, the planes and outline are left out (DepthFootprint::planesLeftOut).
+    bool boxDepth(const ObjectProjection& object, const Aabb& local, DepthFootprint& out, bool planes = true) const;
+    /// boxDepth for a box whose matrix is no float matrix (`object` from the dmat4
+    /// objectProjection): the same footprint, planes and outline, with the same margins for
+    /// rounding. A box too thin for those margins is left to the caller, who knows its float
+    /// vertices (std::nullopt); otherwise false if it reaches the near plane.
+    std::optional<bool> frameBoxDepth(const ObjectProjection& object, const Aabb& local, DepthFootprint& out, bool planes = true) const;
     /// boxDepth's `centres` and `nearest` alone, all a depth-pyramid test reads (the
     /// clusters' test, by the tens of thousands a frame).
     /// With `corners`, also what its front faces' planes are computed from (frontFacePlanes).

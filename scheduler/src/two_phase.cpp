@@ -6,7 +6,9 @@
 //     pyramid (a rectangle and a depth, a few nanoseconds; where that cannot decide, texel
 //     by texel, the volume's depth bounded by its front faces' planes); an occluded node's
 //     subtree is skipped;
-//  4. the parts the pyramid let through are tested exactly, per pixel, in batched raster
+//  4. the parts the pyramid let through are tested again against a pyramid of the depth
+//     after the early parts' deferred clusters are drawn (the surfaces newly in view, which
+//     hide most of them), and those left exactly, per pixel, in batched raster
 //     tests (NVIDIA's gl_occlusion_culling "temporal current frame" scheme), in rounds
 //     front to back, each against the depth drawn before it, and the visible ones drawn
 //     (their clusters against a pyramid built again from that depth, where it pays); then
@@ -98,6 +100,8 @@ void QueryScheduler::runTwoPhase(Frame& f) {
 
     // 3. Late pass.
     candidates_.clear();
+    candidateFootprints_.clear();
+    candidateMargins_.clear();
     candidateMarginNs_ = 0.0;
     refresh_.clear();
     triangleTests_.clear();
@@ -111,10 +115,12 @@ void QueryScheduler::runTwoPhase(Frame& f) {
     joinDeferredSelection();  // the worker, done by now, never outlives the late pass
     if (f.useClusterBits) clusterBitsSavedNs_ = double(deferredTriangles_) * params_.tuning.costs.drawNsPerTriangle;
 
-    // 4. The batched raster test, exact per pixel against the early pass's depth, for the
-    // parts the pyramid let through; then every part drawn after a test (early, or late
+    // 4. The batched raster test, exact per pixel against the depth drawn so far, for the
+    // parts the pyramid let through (first tested again against a pyramid of the depth the
+    // deferred clusters drew, which hides most of them); then every part drawn after a test (early, or late
     // after this one) against the final depth: one hidden there is not drawn early next
     // frame (the first frame, which has no early set, would otherwise draw everything twice).
+    if (!candidates_.empty()) testCandidatesOnLateDepth(f);
     if (!candidates_.empty()) testCandidates(f, triangles);
     if (!triangleTests_.empty()) testTriangles(f);
     if (triangles) readDrawMarks(f);
@@ -210,7 +216,7 @@ void QueryScheduler::lateTraversal(Frame& f, bool testing, bool haveDepth, bool 
         // world box of a rotated part), scene nodes by their box; both grown by rounding.
         DepthFootprint fp;
         const auto tTest = params_.tuning.splitDrawWaits ? SchedulerClock::now() : SchedulerClock::time_point{};
-        const bool inFront = testedFootprint(f, ref, fp);
+        const bool inFront = testedFootprint(f, ref, fp, false);
         const ScreenRect& rect = fp.rect;
         bool certain = false;  // visible without any test (near plane, camera inside)
         if (!inFront || box.contains(f.camera().position)) {
@@ -223,7 +229,7 @@ void QueryScheduler::lateTraversal(Frame& f, bool testing, bool haveDepth, bool 
             continue;
         } else if (haveDepth) {
             ++f.stats.depthTests;
-            const bool occluded = pyramidHides(f, fp);
+            const bool occluded = pyramidHides(f, ref, fp);
             if (params_.tuning.splitDrawWaits) f.stats.pyramidTestMs += msSince(tTest);
             if (occluded) {
                 ++f.stats.queriesOccluded;
@@ -255,7 +261,9 @@ void QueryScheduler::lateTraversal(Frame& f, bool testing, bool haveDepth, bool 
         } else if (const double margin = raster && !certain ? testMarginNs(f, ref, rect, candidateOccludedRate_) : 0.0;
                    raster && !certain && (!params_.features.useCostModel || margin > 0.0 || exploring(ref))) {
             candidates_.push_back(ref);
-            candidateMarginNs_ += std::max(margin, 0.0);  // an exploring part rides along where the round pays
+            candidateFootprints_.push_back(fp);
+            candidateMargins_.push_back(std::max(margin, 0.0));  // an exploring part rides along where the round pays
+            candidateMarginNs_ += std::max(margin, 0.0);
         } else {
             if (raster && !certain) ++f.stats.skippedByCost;
             note(certain ? NodeState::VisibleNear : testing && !raster ? NodeState::VisibleQueried : NodeState::VisibleCheaper);
@@ -333,6 +341,39 @@ void QueryScheduler::testCandidates(Frame& f, bool triangles) {
     spendErrorBudget(f);
     refreshClusterPyramid(f);
     settleCandidates(f, triangles);
+}
+
+void QueryScheduler::testCandidatesOnLateDepth(Frame& f) {
+    // The deferred clusters are what came into view since last frame, in front of much
+    // that the early depth did not hide. Their depth costs a read (the raster test would
+    // wait for the same drawing) and a build; each candidate it hides saves a raster test.
+    if (!params_.features.useLatePyramid || !f.clusterPyramid || f.stats.deferredClustersDrawn == 0) return;
+    assert(candidateFootprints_.size() == candidates_.size() && candidateMargins_.size() == candidates_.size());
+    const TestCosts& c = params_.tuning.costs;
+    if (params_.features.useCostModel &&
+        double(candidates_.size()) * c.testNsPerVolume * candidateOccludedRate_ <= c.pyramidNs)
+        return;
+    f.clusterPyramid = buildPyramid(f);  // the parts drawn after it test their clusters against it too
+    if (!f.clusterPyramid) return;
+    std::size_t kept = 0;
+    candidateMarginNs_ = 0.0;
+    for (std::size_t i = 0; i < candidates_.size(); ++i) {
+        const NodeRef ref = candidates_[i];
+        ++f.stats.depthTests;
+        if (pyramidHides(f, ref, candidateFootprints_[i])) {
+            ++f.stats.queriesOccluded;
+            culledTriangles_ += subtreeTriangles(f, ref);
+            history_.recordAnswer(history_.at(ref, f.objects), false, f.index);
+            f.note(ref, NodeState::Occluded);
+            continue;
+        }
+        candidates_[kept] = ref;
+        candidateMarginNs_ += candidateMargins_[i];
+        ++kept;
+    }
+    // The model's rate is of every candidate, hidden here or by the raster test.
+    learnOccludedRate(candidateOccludedRate_, candidates_.size() - kept, candidates_.size());
+    candidates_.resize(kept);
 }
 
 void QueryScheduler::refreshClusterPyramid(Frame& f) {
@@ -419,7 +460,7 @@ bool QueryScheduler::testOnFinalPyramid(Frame& f) {
     for (const NodeRef ref : refresh_) {
         DepthFootprint fp;
         ++f.stats.depthTests;
-        const bool hidden = testedFootprint(f, ref, fp) && !fp.rect.empty() && pyramidHides(f, fp);
+        const bool hidden = testedFootprint(f, ref, fp, false) && !fp.rect.empty() && pyramidHides(f, ref, fp);
         if (hidden) culledTriangles_ += subtreeTriangles(f, ref);
         hiddenParts += hidden;
         history_.recordAnswer(history_.at(ref, f.objects), !hidden, f.index);
@@ -531,25 +572,36 @@ float QueryScheduler::testedAutoSaving(const Frame& f, NodeRef ref) const {
     return asClusters ? 1.0f : params_.tuning.autoVolumeSaving;
 }
 
-bool QueryScheduler::pyramidHides(Frame& f, const DepthFootprint& fp) const {
+bool QueryScheduler::pyramidHides(Frame& f, NodeRef ref, DepthFootprint& fp) const {
     // The pyramid exists only for a single-sample target, where a volume that covers no
     // pixel centre draws nothing.
     if (fp.centres.empty() || pyramid_.occluded(fp.centres, fp.nearest, params_.tuning.pyramidSpan)) return true;
     if (params_.tuning.texelTestTexels == 0) return false;
+    // The same footprint again, with its planes: made only for what the span test let through.
+    if (fp.planesLeftOut && !testedFootprint(f, ref, fp, true)) return false;
     const bool hidden = pyramid_.occludedPerTexel(fp.centres, fp.nearest, fp.planes, params_.tuning.texelTestTexels);
     f.stats.texelOccluded += hidden;
     return hidden;
 }
 
-bool QueryScheduler::testedFootprint(const Frame& f, NodeRef ref, DepthFootprint& out) const {
-    if (ref.isSceneNode()) return f.screen.boxDepth(f.screen.worldProjection(), f.tree.worldBox(ref), out);
+bool QueryScheduler::testedFootprint(const Frame& f, NodeRef ref, DepthFootprint& out, bool planes) const {
+    if (ref.isSceneNode()) return f.screen.boxDepth(f.screen.worldProjection(), f.tree.worldBox(ref), out, planes);
     if (!params_.features.useTightVolumes) return f.screen.volumeDepth(testedVolume(f, ref), out);
     const SceneObjects& objs = f.objects;
-    if (objectNodeVolumeKind(objs, ref, params_.tuning.volume, testedAutoSaving(f, ref)) != VolumeKind::Aabb)
-        return f.screen.volumeDepth(testedVolume(f, ref), out);
+    const VolumeKind kind = objectNodeVolumeKind(objs, ref, params_.tuning.volume, testedAutoSaving(f, ref));
+    if (kind == VolumeKind::Obb && params_.features.useObbFrames) {
+        // As a box in its own frame: its front faces' planes and its outline too.
+        const std::optional<glm::dmat4> frame = objectNodeObbFrame(objs, ref);
+        if (frame) {
+            static const Aabb kFrameBox{glm::vec3(-1.0f), glm::vec3(1.0f)};
+            if (const std::optional<bool> inFront = f.screen.frameBoxDepth(f.screen.objectProjection(*frame), kFrameBox, out, planes))
+                return *inFront;
+        }
+    }
+    if (kind != VolumeKind::Aabb) return f.screen.volumeDepth(testedVolume(f, ref), out);
     const Aabb box = objectNodeBox(objs, ref, params_.tuning.volume);
     if (box.empty()) return f.screen.volumeDepth(testedVolume(f, ref), out);
-    return f.screen.boxDepth(f.screen.objectProjection(objs.matrix(ref.object)), box, out);
+    return f.screen.boxDepth(f.screen.objectProjection(objs.matrix(ref.object)), box, out, planes);
 }
 
 void QueryScheduler::rasterTest(Frame& f, const std::vector<NodeRef>& parts, bool countSamples) {

@@ -59,6 +59,10 @@ TEST(BenchModes, AblationsOfFullAndTheirVolumes) {
     EXPECT_FALSE(modeFromName("full-rasterrefresh")->scheduler.features.useRefreshPyramid);
     EXPECT_TRUE(modeFromName("full")->scheduler.features.useLearnedClusters);
     EXPECT_FALSE(modeFromName("full-ownrecord")->scheduler.features.useLearnedClusters);
+    EXPECT_TRUE(modeFromName("full")->scheduler.features.useObbFrames);
+    EXPECT_FALSE(modeFromName("full-obbpoints")->scheduler.features.useObbFrames);
+    EXPECT_TRUE(modeFromName("full")->scheduler.features.useLatePyramid);
+    EXPECT_FALSE(modeFromName("full-nolatepyramid")->scheduler.features.useLatePyramid);
     EXPECT_GT(modeFromName("full")->scheduler.tuning.texelTestTexels, 0);
     EXPECT_EQ(modeFromName("full-notexel")->scheduler.tuning.texelTestTexels, 0);
     EXPECT_EQ(modeFromName("full-notexel")->scheduler.tuning.clusterTexelTests, 0);

@@ -8,6 +8,8 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
 
+#include "dyncull/objects/obb.hpp"
+#include "dyncull/scheduler/query_scheduler.hpp"
 #include "screen_projection.hpp"
 
 namespace dyncull {
@@ -192,6 +194,91 @@ TEST(ScreenProjection, FrontFacePlanesAreNeverBehindTheBox) {
         EXPECT_EQ(fp.planes.count, 0u);
         EXPECT_GE(fp.planes.edgeCount, 4u);
     }
+}
+
+// A part's PCA box projected as a box in its own frame (boxFrame of its float corners,
+// frameBoxDepth): every point the box was fitted to, under the object's float matrix, lies
+// inside the footprint's rectangle and outline, and no nearer than its nearest depth or any
+// front-face plane at its own window position; at three scales and far from the origin.
+TEST(ScreenProjection, AnObbInItsOwnFrameBoundsItsPoints) {
+    std::mt19937 rng(29);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    int projected = 0, withPlanes = 0;
+    for (const float scale : {1.0f, 1e-3f, 1e4f}) {
+        for (int i = 0; i < 200; ++i) {
+            Case c = randomCase(rng, false, scale);
+            if (i % 4 == 3) {  // far from the origin
+                const glm::vec3 far(3e6f * scale, -2e6f * scale, 1e6f * scale);
+                c.camera.position += far;
+                c.camera.target += far;
+                c.matrix = glm::translate(glm::mat4(1.0f), far) * c.matrix;
+            }
+            // A stretched, rotated cloud (planar every fifth case: a flat box takes the thin path).
+            const glm::mat3 shape = glm::mat3(glm::rotate(glm::mat4(1.0f), 3.0f * u(rng), glm::normalize(glm::vec3(u(rng), u(rng), 1.0f)))) *
+                                    glm::mat3(glm::scale(glm::mat4(1.0f), glm::vec3(1.0f, 0.3f, i % 5 == 0 ? 0.0f : 0.1f)));
+            std::vector<glm::vec3> points(40);
+            for (glm::vec3& p : points) p = shape * glm::vec3(u(rng), u(rng), u(rng)) + glm::vec3(0.2f);
+            const Obb obb = fitObbPca(points);
+            const std::array<glm::vec3, 8> corners = obb.corners();
+            const FrameView view = FrameView::of(c.camera, 640, 360);
+            const ScreenProjection screen(view);
+            DepthFootprint fp;
+            const std::optional<bool> inFront =
+                screen.frameBoxDepth(screen.objectProjection(glm::dmat4(c.matrix) * boxFrame(corners)), Aabb{glm::vec3(-1.0f), glm::vec3(1.0f)}, fp);
+            if (!inFront || !*inFront) continue;  // thin (the caller's volume path), or at the near plane
+            ++projected;
+            withPlanes += fp.planes.count > 0;
+            for (const glm::vec3& p : points) {
+                const glm::dvec3 world(c.matrix * glm::vec4(p, 1.0f));  // the float transform a GPU makes
+                const glm::dvec4 clip = view.viewProjRelative * glm::dvec4(world - glm::dvec3(c.camera.position), 1.0);
+                const glm::dvec2 px = (glm::dvec2(clip) / clip.w + 1.0) * 0.5 * glm::dvec2(view.width, view.height);
+                const double depth = clip.z / clip.w;
+                EXPECT_LE(depth, double(fp.nearest) + 1e-7) << "case " << i;
+                if (px.x >= 0.0 && px.x <= view.width && px.y >= 0.0 && px.y <= view.height) {
+                    EXPECT_GE(px.x, fp.rect.x0);
+                    EXPECT_LE(px.x, fp.rect.x1);
+                    EXPECT_GE(px.y, fp.rect.y0);
+                    EXPECT_LE(px.y, fp.rect.y1);
+                }
+                for (std::uint32_t j = 0; j < fp.planes.count; ++j) {
+                    const auto& [a, b, d0] = fp.planes.planes[j];
+                    EXPECT_GE(a * px.x + b * px.y + d0, depth - 1e-9 * std::abs(depth)) << "case " << i << ", plane " << j;
+                }
+                for (std::uint32_t j = 0; j < fp.planes.edgeCount; ++j) {
+                    const auto& [a, b, d0] = fp.planes.edges[j];
+                    EXPECT_LE(a * px.x + b * px.y, d0 + 1e-9 * (std::abs(a * px.x) + std::abs(b * px.y) + std::abs(d0)))
+                        << "case " << i << ", edge " << j;
+                }
+            }
+        }
+    }
+    EXPECT_GT(projected, 200) << "too few boxes in front of the eye to check";
+    EXPECT_GT(withPlanes, 100);
+}
+
+// Left out, the planes and outline are empty and said to be; asked for, the same footprint
+// has them.
+TEST(ScreenProjection, PlanesLeftOutAreMadeOnRequest) {
+    std::mt19937 rng(31);
+    int checked = 0;
+    for (int i = 0; i < 200; ++i) {
+        const Case c = randomCase(rng, false, 1.0f);
+        const FrameView view = FrameView::of(c.camera, 640, 360);
+        const ScreenProjection screen(view);
+        DepthFootprint without, with;
+        const bool inFront = screen.boxDepth(screen.objectProjection(c.matrix), c.box, without, false);
+        ASSERT_EQ(screen.boxDepth(screen.objectProjection(c.matrix), c.box, with), inFront);
+        if (!inFront) continue;
+        EXPECT_TRUE(without.planesLeftOut);
+        EXPECT_FALSE(with.planesLeftOut);
+        EXPECT_EQ(without.planes.count, 0u);
+        EXPECT_EQ(without.planes.edgeCount, 0u);
+        EXPECT_EQ(without.rect, with.rect);
+        EXPECT_EQ(without.centres, with.centres);
+        EXPECT_EQ(without.nearest, with.nearest);
+        checked += with.planes.edgeCount > 0;
+    }
+    EXPECT_GT(checked, 50);
 }
 
 TEST(ScreenProjection, BoxAroundTheEyeIsVisible) {

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -121,6 +122,18 @@ struct SchedulerFeatures {
     /// answer has waited for already), so their clusters are tested against it rather
     /// than the early pass's depth. Off: an ablation, bench mode full-noroundpyramid.
     bool useRoundPyramids = true;
+    /// TwoPhase: a part tested with its PCA box is projected as a box in the box's own
+    /// frame (objectNodeObbFrame), so its per-texel test has the box's front faces' planes
+    /// and outline, as an axis-aligned box has, rather than its nearest depth over its
+    /// whole footprint rectangle. Off: an ablation, bench mode full-obbpoints.
+    bool useObbFrames = true;
+    /// TwoPhase with cluster history: once the late pass has drawn the early parts'
+    /// deferred clusters (the surfaces that came into view since last frame), the pyramid
+    /// is built again from that depth, and the parts waiting for the batched raster test
+    /// are tested against it first; most of them are hidden behind what was just drawn,
+    /// and a pyramid test is a few hundred times cheaper than a raster test. Off: an
+    /// ablation, bench mode full-nolatepyramid.
+    bool useLatePyramid = true;
     /// TwoPhase (and clusters): test only where SchedulerTuning::costs expects the test to
     /// pay. Off: every volume the pyramid lets through is tested (an ablation).
     bool useCostModel = true;
@@ -373,12 +386,21 @@ VolumeKind objectNodeVolumeKind(const SceneObjects& objects, NodeRef ref, Volume
 /// Where that kind is Aabb, the object-space box whose corners objectNodeVolume transforms:
 /// the node's box, or its stored box volume's; empty where it takes the world AABB instead.
 Aabb objectNodeBox(const SceneObjects& objects, NodeRef ref, VolumeChoice volume);
+/// The affine map from a frame in which a box is [-1, 1]^3 to the space of its 8 `corners`
+/// (in boxCorners' order: bit k of the index picks the side along axis k; a PCA box's, whose
+/// axes need not be the space's): their centre and half axes, averaged over the corners, so
+/// within a rounding or two of every corner. Double.
+glm::dmat4 boxFrame(std::span<const glm::vec3, 8> corners);
+/// Where objectNodeVolumeKind is Obb: the object's matrix times boxFrame of object node
+/// `ref`'s PCA box, object space to world. std::nullopt where the node has no stored PCA box.
+std::optional<glm::dmat4> objectNodeObbFrame(const SceneObjects& objects, NodeRef ref);
 
 /// Runs one frame of culling and drawing. Owns the visibility history between frames;
 /// borrows the tree, backend and sink for the duration of cullFrame.
 class QueryIssuer;
 class DeferredQueries;
 struct DepthFootprint;
+struct ObjectProjection;
 class DrawQueries;
 
 class QueryScheduler {
@@ -530,6 +552,14 @@ private:
     std::vector<NodeRef> candidates_, refresh_;
     std::vector<NodeRef> allCandidates_;  // every candidate while they are tested in rounds
     double candidateMarginNs_ = 0.0;      // this frame's candidates' testMarginNs, summed
+    // Per entry of candidates_ (until testCandidates): its footprint and testMarginNs, as
+    // the late traversal computed them.
+    std::vector<DepthFootprint> candidateFootprints_;
+    std::vector<double> candidateMargins_;
+    /// SchedulerFeatures::useLatePyramid: after the deferred clusters are drawn, the
+    /// pyramid built again from that depth and candidates_ tested against it; the hidden
+    /// ones are settled as occluded, and only the others go to the raster test.
+    void testCandidatesOnLateDepth(Frame& f);
     std::uint32_t lastCandidateBatchFrame_ = 0;  // the last frame whose candidates were raster-tested
     /// How many rounds of raster tests this frame's candidates get: candidateRounds (at
     /// most one per candidate), fewer where their summed margins do not pay for each
@@ -543,8 +573,9 @@ private:
     float testedAutoSaving(const Frame& f, NodeRef ref) const;
     /// testedVolume(f, ref)'s footprint (ScreenProjection::volumeDepth), a box's computed
     /// from its centre and axes without building the volume (ScreenProjection::boxDepth);
-    /// false if it reaches the near plane.
-    bool testedFootprint(const Frame& f, NodeRef ref, DepthFootprint& out) const;
+    /// false if it reaches the near plane. With `planes` off, a box's planes and outline
+    /// are left out (pyramidHides makes them where its span test cannot decide).
+    bool testedFootprint(const Frame& f, NodeRef ref, DepthFootprint& out, bool planes = true) const;
     /// The cost model's measured rates of "occluded" answers, for parts new this frame and
     /// for parts drawn early and tested again (moving averages over frames), and for the
     /// triangle tests of parts whose volumes passed.
@@ -587,8 +618,9 @@ private:
     /// False if the depth could not be read (nothing recorded).
     bool testOnFinalPyramid(Frame& f);
     /// The late pass's pyramid test of a volume's footprint: at pyramidSpan, then texel by
-    /// texel (SchedulerTuning::texelTestTexels). True if hidden behind the pyramid.
-    bool pyramidHides(Frame& f, const DepthFootprint& fp) const;
+    /// texel (SchedulerTuning::texelTestTexels). True if hidden behind the pyramid. `fp` is
+    /// `ref`'s footprint; its planes are made here if they were left out and are needed.
+    bool pyramidHides(Frame& f, NodeRef ref, DepthFootprint& fp) const;
     /// True if a triangle test of `ref` is expected to save more drawing than it costs.
     bool worthTriangleTest(const Frame& f, NodeRef ref);
     /// Tests triangleTests_ (PartSink::testParts), draws the visible ones, records the answers.
