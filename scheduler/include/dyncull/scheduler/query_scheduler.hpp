@@ -130,9 +130,10 @@ struct SchedulerFeatures {
     /// TwoPhase with cluster history: once the late pass has drawn the early parts'
     /// deferred clusters (the surfaces that came into view since last frame), the pyramid
     /// is built again from that depth, and the parts waiting for the batched raster test
-    /// are tested against it first; most of them are hidden behind what was just drawn,
-    /// and a pyramid test is a few hundred times cheaper than a raster test. Off: an
-    /// ablation, bench mode full-nolatepyramid.
+    /// are tested against it first: on the bunny path nine in ten are hidden behind what
+    /// was just drawn, and their footprints are kept from the late traversal, so a test
+    /// there costs a fraction of a batched raster test's (TestCosts::testNsPerVolume).
+    /// Priced as a round pyramid. Off: an ablation, bench mode full-nolatepyramid.
     bool useLatePyramid = true;
     /// TwoPhase (and clusters): test only where SchedulerTuning::costs expects the test to
     /// pay. Off: every volume the pyramid lets through is tested (an ablation).
