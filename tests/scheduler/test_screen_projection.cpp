@@ -4,6 +4,7 @@
 // orthographic, with degenerate (flat) boxes and huge coordinates on purpose.
 #include <cmath>
 #include <random>
+#include <string>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
@@ -77,6 +78,33 @@ void compare(const Case& c, int& projected) {
             EXPECT_GE(px.y, fast.rect.y0);
             EXPECT_LE(px.y, fast.rect.y1);
         }
+    }
+}
+
+// Checks that point `world` (world space; the eye is subtracted here) lies no
+// nearer than `fp`'s nearest depth and front-face planes at its own window position, inside
+// its outline, and inside its rectangle where it is on screen. `what` names the case.
+void expectBoundsPoint(const DepthFootprint& fp, const FrameView& view, const Camera& camera, const glm::dvec3& world, bool checkRect,
+                       const std::string& what) {
+    const glm::dvec4 clip = view.viewProjRelative * glm::dvec4(world - glm::dvec3(camera.position), 1.0);
+    const glm::dvec2 px = (glm::dvec2(clip) / clip.w + 1.0) * 0.5 * glm::dvec2(view.width, view.height);
+    const double depth = clip.z / clip.w;
+    if (checkRect) {
+        EXPECT_LE(depth, double(fp.nearest) + 1e-7) << what;
+        if (px.x >= 0.0 && px.x <= view.width && px.y >= 0.0 && px.y <= view.height) {
+            EXPECT_GE(px.x, fp.rect.x0) << what;
+            EXPECT_LE(px.x, fp.rect.x1) << what;
+            EXPECT_GE(px.y, fp.rect.y0) << what;
+            EXPECT_LE(px.y, fp.rect.y1) << what;
+        }
+    }
+    for (std::uint32_t j = 0; j < fp.planes.count; ++j) {
+        const auto& [a, b, d0] = fp.planes.planes[j];
+        EXPECT_GE(a * px.x + b * px.y + d0, depth - 1e-9 * std::abs(depth)) << what << ", plane " << j;
+    }
+    for (std::uint32_t j = 0; j < fp.planes.edgeCount; ++j) {
+        const auto& [a, b, d0] = fp.planes.edges[j];
+        EXPECT_LE(a * px.x + b * px.y, d0 + 1e-9 * (std::abs(a * px.x) + std::abs(b * px.y) + std::abs(d0))) << what << ", edge " << j;
     }
 }
 
@@ -165,19 +193,7 @@ TEST(ScreenProjection, FrontFacePlanesAreNeverBehindTheBox) {
                 if (k < 8) t = glm::dvec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
                 else if (k < 32) t[k % 3] = (k & 8) ? 1.0 : 0.0;
                 const glm::dvec3 local = glm::dvec3(c.box.min) + t * (glm::dvec3(c.box.max) - glm::dvec3(c.box.min));
-                const glm::dvec3 rel = glm::dvec3(glm::dmat4(c.matrix) * glm::dvec4(local, 1.0)) - glm::dvec3(c.camera.position);
-                const glm::dvec4 clip = view.viewProjRelative * glm::dvec4(rel, 1.0);
-                const glm::dvec2 px = (glm::dvec2(clip) / clip.w + 1.0) * 0.5 * glm::dvec2(view.width, view.height);
-                const double depth = clip.z / clip.w;
-                for (std::uint32_t j = 0; j < fp.planes.count; ++j) {
-                    const auto& [a, b, d0] = fp.planes.planes[j];
-                    EXPECT_GE(a * px.x + b * px.y + d0, depth - 1e-9 * std::abs(depth)) << "case " << i << ", plane " << j;
-                }
-                for (std::uint32_t j = 0; j < fp.planes.edgeCount; ++j) {
-                    const auto& [a, b, d0] = fp.planes.edges[j];
-                    EXPECT_LE(a * px.x + b * px.y, d0 + 1e-9 * (std::abs(a * px.x) + std::abs(b * px.y) + std::abs(d0)))
-                        << "case " << i << ", edge " << j;
-                }
+                expectBoundsPoint(fp, view, c.camera, glm::dvec3(glm::dmat4(c.matrix) * glm::dvec4(local, 1.0)), false, "case " + std::to_string(i));
                 ++points;
             }
         }
@@ -228,28 +244,8 @@ TEST(ScreenProjection, AnObbInItsOwnFrameBoundsItsPoints) {
             if (!inFront || !*inFront) continue;  // thin (the caller's volume path), or at the near plane
             ++projected;
             withPlanes += fp.planes.count > 0;
-            for (const glm::vec3& p : points) {
-                const glm::dvec3 world(c.matrix * glm::vec4(p, 1.0f));  // the float transform a GPU makes
-                const glm::dvec4 clip = view.viewProjRelative * glm::dvec4(world - glm::dvec3(c.camera.position), 1.0);
-                const glm::dvec2 px = (glm::dvec2(clip) / clip.w + 1.0) * 0.5 * glm::dvec2(view.width, view.height);
-                const double depth = clip.z / clip.w;
-                EXPECT_LE(depth, double(fp.nearest) + 1e-7) << "case " << i;
-                if (px.x >= 0.0 && px.x <= view.width && px.y >= 0.0 && px.y <= view.height) {
-                    EXPECT_GE(px.x, fp.rect.x0);
-                    EXPECT_LE(px.x, fp.rect.x1);
-                    EXPECT_GE(px.y, fp.rect.y0);
-                    EXPECT_LE(px.y, fp.rect.y1);
-                }
-                for (std::uint32_t j = 0; j < fp.planes.count; ++j) {
-                    const auto& [a, b, d0] = fp.planes.planes[j];
-                    EXPECT_GE(a * px.x + b * px.y + d0, depth - 1e-9 * std::abs(depth)) << "case " << i << ", plane " << j;
-                }
-                for (std::uint32_t j = 0; j < fp.planes.edgeCount; ++j) {
-                    const auto& [a, b, d0] = fp.planes.edges[j];
-                    EXPECT_LE(a * px.x + b * px.y, d0 + 1e-9 * (std::abs(a * px.x) + std::abs(b * px.y) + std::abs(d0)))
-                        << "case " << i << ", edge " << j;
-                }
-            }
+            for (const glm::vec3& p : points)  // under the float transform a GPU makes
+                expectBoundsPoint(fp, view, c.camera, glm::dvec3(c.matrix * glm::vec4(p, 1.0f)), true, "case " + std::to_string(i));
         }
     }
     EXPECT_GT(projected, 200) << "too few boxes in front of the eye to check";
